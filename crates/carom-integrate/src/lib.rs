@@ -1,0 +1,3 @@
+//! Integrators and force fields.
+//!
+//! Work in progress (issue 3).

@@ -1,0 +1,3 @@
+//! Collision response: what a collision does to the bodies.
+//!
+//! Work in progress (issue 3).
