@@ -1,0 +1,7 @@
+//! carom's engines and the scene model they run.
+//!
+//! * [`scene`]: the typed scene (balls, boxes, border, world settings), its validation,
+//!   and the TOML scene-file loader of the `carom run` contract (docs/scene-format.md).
+
+pub mod scene;
+pub mod scenes;

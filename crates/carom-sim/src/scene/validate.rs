@@ -1,0 +1,142 @@
+//! The rules of the scene contract, checked on a typed [`Scene`].
+//!
+//! Field rules (finite numbers, positive radius and mass, restitution in `[0, 1]`, ...)
+//! and placement rules (balls inside the border, no overlap between balls or with a
+//! box by more than [`OVERLAP_TOLERANCE`]). Every error names the entry and the field,
+//! e.g. `balls[3].radius: must be > 0, got -0.1`.
+
+use std::fmt;
+
+use carom_math::{
+    InvalidValue, Real, ensure_finite_vector, ensure_in_range, ensure_non_negative, ensure_positive,
+};
+
+use super::Scene;
+
+/// How much two bodies may overlap at the start (m): touching (gap 0) is allowed,
+/// overlaps up to this are accepted as rounding in hand-written files.
+pub const OVERLAP_TOLERANCE: f64 = 1e-9;
+
+/// A scene that breaks a rule of the contract: where, and what is wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub struct SceneError {
+    /// The scene file, when the scene came from one.
+    pub file: Option<String>,
+    /// The offending entry and field, e.g. `balls[3].radius` (empty for the whole file).
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl SceneError {
+    /// An error at `field`.
+    pub fn new(field: impl Into<String>, message: impl Into<String>) -> Self {
+        Self {
+            file: None,
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The same error, attributed to the scene file `file`.
+    #[must_use]
+    pub fn in_file(mut self, file: impl Into<String>) -> Self {
+        self.file = Some(file.into());
+        self
+    }
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(file) = &self.file {
+            write!(f, "{file}: ")?;
+        }
+        if self.field.is_empty() {
+            write!(f, "{}", self.message)
+        } else {
+            write!(f, "{}: {}", self.field, self.message)
+        }
+    }
+}
+
+impl From<InvalidValue> for SceneError {
+    fn from(e: InvalidValue) -> Self {
+        Self::new(e.field.into_owned(), e.problem.to_string())
+    }
+}
+
+fn at(context: &str) -> impl Fn(InvalidValue) -> SceneError + '_ {
+    move |e| SceneError::from(e.within(context))
+}
+
+fn restitution<T: Real>(x: T) -> Result<T, InvalidValue> {
+    ensure_in_range("restitution", x, T::zero(), T::one())
+}
+
+impl<T: Real, const D: usize> Scene<T, D> {
+    /// Checks every rule of the scene contract.
+    ///
+    /// # Errors
+    /// The first broken rule, naming the entry and field (`world.gravity[1]`,
+    /// `balls[3].radius`, `boxes[0].half_extents[2]`, `balls[4]` for a placement).
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.validate_fields()?;
+        self.validate_placement()
+    }
+
+    fn validate_fields(&self) -> Result<(), SceneError> {
+        let w = &self.world;
+        let world = at("world");
+        ensure_finite_vector("gravity", &w.gravity).map_err(&world)?;
+        restitution(w.restitution).map_err(&world)?;
+        ensure_non_negative("friction", w.friction).map_err(&world)?;
+        ensure_non_negative("drag", w.drag).map_err(&world)?;
+        if let Some(b) = &w.border {
+            restitution(b.restitution).map_err(at("world.border"))?;
+        }
+        for (i, b) in self.balls.iter().enumerate() {
+            let ctx = format!("balls[{i}]");
+            let ball = at(&ctx);
+            ensure_finite_vector("pos", &b.pos).map_err(&ball)?;
+            ensure_finite_vector("vel", &b.vel).map_err(&ball)?;
+            ensure_positive("radius", b.radius).map_err(&ball)?;
+            ensure_positive("mass", b.mass).map_err(&ball)?;
+            if let Some(e) = b.restitution {
+                restitution(e).map_err(&ball)?;
+            }
+        }
+        for (i, b) in self.boxes.iter().enumerate() {
+            let ctx = format!("boxes[{i}]");
+            ensure_finite_vector("vel", &b.vel).map_err(at(&ctx))?;
+            restitution(b.restitution).map_err(at(&ctx))?;
+        }
+        Ok(())
+    }
+
+    fn validate_placement(&self) -> Result<(), SceneError> {
+        let tol = T::lit(OVERLAP_TOLERANCE);
+        if let Some(spec) = &self.world.border {
+            let (lo, hi) = (spec.border.min(), spec.border.max());
+            for (i, b) in self.balls.iter().enumerate() {
+                // A periodic box only needs the centre inside; a reflecting one the whole ball.
+                let r = if spec.periodic { T::zero() } else { b.radius };
+                if let Some(k) =
+                    (0..D).find(|&k| b.pos[k] - r < lo[k] - tol || b.pos[k] + r > hi[k] + tol)
+                {
+                    let what = if spec.periodic { "centre" } else { "ball" };
+                    return Err(SceneError::new(
+                        format!("balls[{i}].pos"),
+                        format!(
+                            "the {what} must start inside the border: axis {k} spans [{}, {}], border [{}, {}]",
+                            b.pos[k] - r,
+                            b.pos[k] + r,
+                            lo[k],
+                            hi[k]
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
