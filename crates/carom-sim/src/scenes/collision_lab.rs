@@ -208,8 +208,8 @@ mod tests {
             for constant_size in [false, true] {
                 for reflecting_border in [false, true] {
                     let opts = Options {
-                        constant_size,
                         reflecting_border,
+                        constant_size,
                         ..Options::default()
                     };
                     let s = scene(screen, &opts);
