@@ -1,0 +1,3 @@
+//! The exact event-driven engine.
+
+pub mod calendar;
