@@ -42,8 +42,7 @@ pub struct Calendar<T: Real> {
     heads: Vec<u32>,
     heap: Vec<u32>,
     overflow: Vec<u32>,
-    /// Bucket width and its inverse.
-    width: T,
+    /// The inverse of the bucket width.
     inv_width: T,
     /// Absolute index of the bucket the heap holds (bucket k spans `[k w, (k+1) w)`).
     current: i64,
@@ -71,7 +70,6 @@ impl<T: Real> Calendar<T> {
             heads: vec![NONE; buckets],
             heap: Vec::with_capacity(64),
             overflow: Vec::new(),
-            width,
             inv_width: T::one() / width,
             current: 0,
             overflow_min: i64::MAX,
@@ -118,9 +116,10 @@ impl<T: Real> Calendar<T> {
     /// Schedules `ball` at time `t`, replacing its previous event. An infinite `t` cancels.
     pub fn schedule(&mut self, ball: usize, t: T) {
         self.cancel(ball);
-        if !(t < T::INFINITY) {
+        if t == T::INFINITY {
             return;
         }
+        debug_assert!(t.finite(), "event times are finite or +infinity");
         self.time[ball] = t;
         self.len += 1;
         self.place(ball as u32);
@@ -282,15 +281,15 @@ impl<T: Real> Calendar<T> {
 
     fn heap_remove(&mut self, pos: usize) {
         let last = self.heap.len() - 1;
-        if pos != last {
+        if pos == last {
+            self.heap.pop();
+        } else {
             self.heap.swap(pos, last);
             let moved = self.heap[pos];
             self.slot[moved as usize] = Slot::Heap(pos as u32);
             self.heap.pop();
             let pos = self.sift_up(pos);
             self.sift_down(pos);
-        } else {
-            self.heap.pop();
         }
     }
 
