@@ -1,3 +1,4 @@
 //! The exact event-driven engine.
 
 pub mod calendar;
+pub mod neighbours;
