@@ -7,7 +7,7 @@
 //! With restitution `e < 1`, a group of balls can collide infinitely often in finite
 //! time: each collision shrinks the relative velocities by a constant factor, so the
 //! times between collisions form a convergent geometric series (McNamara and Young,
-//! Phys. Fluids A 4, 496 (1992); three balls on a line collapse for
+//! Phys. Fluids A 4, 496 (1992); three balls on a line can collapse only for
 //! `e < 7 − 4√3 ≈ 0.072`, Constantin, Grossman and Mungan, Physica D 84, 1995). An
 //! event-driven engine then never gets past the accumulation time. Two guards:
 //!

@@ -211,7 +211,7 @@ proptest! {
                 (v1 + w1.cross(&rb) - v0 - w0.cross(&ra)).dot(&n)
             };
             let after_n = rel(&r.velocity[0], &r.velocity[1], &r.angular_velocity[0], &r.angular_velocity[1]);
-            let speed = va.norm() + vb.norm() + (wa.norm() + wb.norm()) * 2.0 + r.velocity.iter().map(|v| v.norm()).sum::<f64>()
+            let speed = va.norm() + vb.norm() + (wa.norm() + wb.norm()) * 2.0 + r.velocity.iter().map(Vector3::norm).sum::<f64>()
                 + r.angular_velocity.iter().map(|w| w.norm() * 2.0).sum::<f64>();
             prop_assert!((after_n + e * r.normal_velocity).abs() <= 1e-12 * speed);
         }

@@ -15,6 +15,9 @@ use common::angular;
 use nalgebra::{Const, Matrix3, SVector, Vector1, Vector2, Vector3};
 use proptest::prelude::*;
 
+/// The linear and angular velocity of each body of a pair.
+type Motions<const D: usize> = [(SVector<f64, D>, Angular<f64, D>); 2];
+
 /// The allowed round-trip error in units of `ε ×` the speed scale.
 const ULPS: f64 = 16.0;
 
@@ -33,7 +36,7 @@ fn round_trip<const D: usize>(
     b: &Body<f64, D>,
     contact: &Contact<f64, D>,
     coefficients: &Coefficients<f64>,
-) -> ([(SVector<f64, D>, Angular<f64, D>); 2], f64)
+) -> (Motions<D>, f64)
 where
     Const<D>: Space<f64, D>,
 {
@@ -73,7 +76,7 @@ where
 fn max_error<const D: usize>(
     bodies: [&Body<f64, D>; 2],
     levers: [f64; 2],
-    result: &[(SVector<f64, D>, Angular<f64, D>); 2],
+    result: &Motions<D>,
 ) -> f64
 where
     Const<D>: Space<f64, D>,
