@@ -181,14 +181,26 @@ where
 {
     a: &'a Body<T, D>,
     b: &'a Body<T, D>,
+    n: Vector<T, D>,
     r_a: Vector<T, D>,
     r_b: Vector<T, D>,
 }
 
-impl<T: Real, const D: usize> Pair<'_, T, D>
+impl<'a, T: Real, const D: usize> Pair<'a, T, D>
 where
     Const<D>: Space<T, D>,
 {
+    #[inline]
+    fn new(a: &'a Body<T, D>, b: &'a Body<T, D>, contact: &Contact<T, D>) -> Self {
+        Self {
+            a,
+            b,
+            n: contact.normal(),
+            r_a: contact.offset_a(),
+            r_b: contact.offset_b(),
+        }
+    }
+
     /// `v_rel = (v_b + ω_b × r_b) − (v_a + ω_a × r_a)`.
     #[inline]
     fn relative_velocity(&self) -> Vector<T, D> {
@@ -210,28 +222,32 @@ where
             + turn(self.b, &self.r_b)
     }
 
-    /// `n·K n`, written as a sum of non-negative terms so that rounding cannot make it
-    /// negative for isotropic inertias.
+    /// For each body, the spin `I⁻¹ (r × n)` a unit normal impulse gives it (on `b`; `a`
+    /// gets the opposite), and `n·K n = 1/m_a + 1/m_b + Σ (r × n)·I⁻¹ (r × n)`, written as
+    /// a sum of non-negative terms so that rounding cannot make it negative for isotropic
+    /// inertias. The spins are reused to apply the normal impulse.
     #[inline]
-    fn normal_stiffness(&self, n: &Vector<T, D>) -> T {
-        let term = |body: &Body<T, D>, r: &Vector<T, D>| {
-            let c = <Const<D> as Space<T, D>>::cross(r, n);
-            <Const<D> as Space<T, D>>::angular_dot(
-                &c,
-                &<Const<D> as Space<T, D>>::inertia_apply(&body.inverse_inertia(), &c),
-            )
+    fn normal_response(&self) -> ([Angular<T, D>; 2], T) {
+        let n = &self.n;
+        let lever = |body: &Body<T, D>, r: &Vector<T, D>| {
+            let torque = <Const<D> as Space<T, D>>::cross(r, n);
+            let spin = <Const<D> as Space<T, D>>::inertia_apply(&body.inverse_inertia(), &torque);
+            (spin, <Const<D> as Space<T, D>>::angular_dot(&torque, &spin))
         };
-        self.a.inverse_mass()
-            + self.b.inverse_mass()
-            + term(self.a, &self.r_a)
-            + term(self.b, &self.r_b)
+        let (spin_a, term_a) = lever(self.a, &self.r_a);
+        let (spin_b, term_b) = lever(self.b, &self.r_b);
+        (
+            [spin_a, spin_b],
+            self.a.inverse_mass() + self.b.inverse_mass() + term_a + term_b,
+        )
     }
 
     /// The tangential impulse `F*` that stops the tangential relative velocity `v_t`:
     /// the solution of `K_tt F* = −v_t` in the plane orthogonal to `n`, by `D − 1`
     /// conjugate-gradient steps (exact in exact arithmetic for the `D − 1` dimensional
     /// symmetric positive definite `K_tt`).
-    fn sticking_impulse(&self, n: &Vector<T, D>, v_t: &Vector<T, D>) -> Vector<T, D> {
+    fn sticking_impulse(&self, v_t: &Vector<T, D>) -> Vector<T, D> {
+        let n = &self.n;
         let tangential = |x: Vector<T, D>| x - n * n.dot(&x);
         let mut x = Vector::<T, D>::zeros();
         let mut residual = -v_t;
@@ -273,13 +289,8 @@ pub fn resolve<T: Real, const D: usize>(
 where
     Const<D>: Space<T, D>,
 {
-    let pair = Pair {
-        a,
-        b,
-        r_a: contact.offset_a(),
-        r_b: contact.offset_b(),
-    };
-    let n = contact.normal();
+    let pair = Pair::new(a, b, contact);
+    let n = pair.n;
     let v_rel = pair.relative_velocity();
     let v_n = v_rel.dot(&n);
     if v_n > T::zero() {
@@ -288,7 +299,7 @@ where
     if v_n == T::zero() {
         return Response::without_impulse(a, b, Outcome::Touching, v_n);
     }
-    let stiffness = pair.normal_stiffness(&n);
+    let (normal_spins, stiffness) = pair.normal_response();
     if stiffness <= T::zero() {
         return Response::without_impulse(a, b, Outcome::Immovable, v_n);
     }
@@ -299,7 +310,7 @@ where
     let (tangential_impulse, friction) = if coefficients.friction() > T::zero() {
         let after_normal = v_rel + pair.apply_k(&normal_impulse);
         let v_t = after_normal - n * n.dot(&after_normal);
-        let sticking = pair.sticking_impulse(&n, &v_t);
+        let sticking = pair.sticking_impulse(&v_t);
         let magnitude = sticking.norm();
         let limit = coefficients.friction() * j_n;
         if magnitude == T::zero() {
@@ -313,39 +324,47 @@ where
         (Vector::zeros(), Friction::None)
     };
 
-    let impulse = normal_impulse + tangential_impulse;
     apply(
         &pair,
         v_rel,
         v_n,
-        j_n,
+        (j_n, normal_spins),
         tangential_impulse,
-        impulse,
         friction,
     )
 }
 
-/// Applies `impulse` (on `b`, `−impulse` on `a`) and reports what it did.
+/// Applies the normal impulse `j_n n` and the friction impulse (on `b`, the opposite on
+/// `a`) and reports what they did. `normal_spins` are the spins of a unit normal impulse.
 fn apply<T: Real, const D: usize>(
     pair: &Pair<'_, T, D>,
     v_rel: Vector<T, D>,
     v_n: T,
-    j_n: T,
+    (j_n, normal_spins): (T, [Angular<T, D>; 2]),
     tangential_impulse: Vector<T, D>,
-    impulse: Vector<T, D>,
     friction: Friction,
 ) -> Response<T, D>
 where
     Const<D>: Space<T, D>,
 {
     let half = T::lit(0.5);
-    // One body's share: the impulse it receives, its new motion, and the work done on it,
-    // ½ P·(v + v') + ½ L·(ω + ω') with L = r × P (exact: ½ m (|v'|² − |v|²) = ½ (m Δv)·(v + v')).
-    let kick = |body: &Body<T, D>, r: &Vector<T, D>, p: Vector<T, D>| {
+    let impulse = pair.n * j_n + tangential_impulse;
+    // One body's share: the impulse it receives (sign ±1), its new motion, and the work
+    // done on it, ½ P·(v + v') + ½ L·(ω + ω') with L = r × P (exact:
+    // ½ m (|v'|² − |v|²) = ½ (m Δv)·(v + v')). The spin change is j_n times the normal
+    // spin plus, with friction, I⁻¹ (r × F).
+    let kick = |body: &Body<T, D>, r: &Vector<T, D>, sign: T, normal_spin: &Angular<T, D>| {
+        let p = impulse * sign;
         let angular = <Const<D> as Space<T, D>>::cross(r, &p);
         let v = body.velocity() + p * body.inverse_mass();
-        let w = body.angular_velocity()
-            + <Const<D> as Space<T, D>>::inertia_apply(&body.inverse_inertia(), &angular);
+        let mut spin = *normal_spin * (j_n * sign);
+        if friction != Friction::None {
+            spin += <Const<D> as Space<T, D>>::inertia_apply(
+                &body.inverse_inertia(),
+                &<Const<D> as Space<T, D>>::cross(r, &(tangential_impulse * sign)),
+            );
+        }
+        let w = body.angular_velocity() + spin;
         let work = if body.is_dynamic() {
             half * (p.dot(&(body.velocity() + v))
                 + <Const<D> as Space<T, D>>::angular_dot(&angular, &(body.angular_velocity() + w)))
@@ -354,8 +373,8 @@ where
         };
         (angular, v, w, work)
     };
-    let (angular_a, v_a, w_a, work_a) = kick(pair.a, &pair.r_a, -impulse);
-    let (angular_b, v_b, w_b, work_b) = kick(pair.b, &pair.r_b, impulse);
+    let (angular_a, v_a, w_a, work_a) = kick(pair.a, &pair.r_a, -T::one(), &normal_spins[0]);
+    let (angular_b, v_b, w_b, work_b) = kick(pair.b, &pair.r_b, T::one(), &normal_spins[1]);
 
     let after = pair.b.with_velocities(v_b, w_b).point_velocity(&pair.r_b)
         - pair.a.with_velocities(v_a, w_a).point_velocity(&pair.r_a);

@@ -126,7 +126,7 @@ fn collision_lab_explore_2d_default_balls_match_its_normal_tangent_decomposition
         let (w1, w2) = collision_lab(m1, m2, v1, v2, normal, e);
         assert_close(r.velocity[0].as_slice(), w1.as_slice(), 1e-14, "v1");
         assert_close(r.velocity[1].as_slice(), w2.as_slice(), 1e-14, "v2");
-        assert_eq!(r.angular_velocity[0].x, 0.0);
+        assert!(r.angular_velocity[0].x.abs() < 1e-14); // r × n = ρ n × n: rounding only
     }
 }
 
