@@ -253,8 +253,11 @@ where
         let mut residual = -v_t;
         let mut direction = residual;
         let mut rr = residual.norm_squared();
+        // Converged when the residual is at rounding level of the right-hand side: for
+        // balls (isotropic K_tt) the first step is already exact.
+        let converged = rr * T::EPSILON * T::EPSILON;
         for _ in 1..D {
-            if rr == T::zero() {
+            if rr <= converged {
                 break;
             }
             let k_direction = tangential(self.apply_k(&direction));
