@@ -6,7 +6,7 @@
 
 mod common;
 
-use carom_response::{Angular, Body, Coefficients, Contact, Outcome, Space, resolve};
+use carom_response::{Angular, Body, Coefficients, Contact, Friction, Outcome, Space, resolve};
 use common::{TestBall, angular};
 use nalgebra::{Const, Matrix3, SVector, Vector1, Vector2, Vector3};
 use proptest::prelude::*;
@@ -205,15 +205,21 @@ proptest! {
             + (inertia_a * r.angular_velocity[0]).norm() + (inertia_b * r.angular_velocity[1]).norm();
         let dl = l(&r.velocity[0], &r.velocity[1], &r.angular_velocity[0], &r.angular_velocity[1]) - l(&va, &vb, &wa, &wb);
         prop_assert!(dl.norm() <= 1e-12 * scale_l, "angular momentum drift {} of {}", dl.norm(), scale_l);
+        let n = contact.normal();
+        let rel = |v0: &Vector3<f64>, v1: &Vector3<f64>, w0: &Vector3<f64>, w1: &Vector3<f64>| {
+            v1 + w1.cross(&rb) - v0 - w0.cross(&ra)
+        };
+        let after = rel(&r.velocity[0], &r.velocity[1], &r.angular_velocity[0], &r.angular_velocity[1]);
+        let speed = va.norm() + vb.norm() + (wa.norm() + wb.norm()) * 2.0 + r.velocity.iter().map(Vector3::norm).sum::<f64>()
+            + r.angular_velocity.iter().map(|w| w.norm() * 2.0).sum::<f64>();
         if mu == 0.0 && r.applied() {
-            let n = contact.normal();
-            let rel = |v0: &Vector3<f64>, v1: &Vector3<f64>, w0: &Vector3<f64>, w1: &Vector3<f64>| {
-                (v1 + w1.cross(&rb) - v0 - w0.cross(&ra)).dot(&n)
-            };
-            let after_n = rel(&r.velocity[0], &r.velocity[1], &r.angular_velocity[0], &r.angular_velocity[1]);
-            let speed = va.norm() + vb.norm() + (wa.norm() + wb.norm()) * 2.0 + r.velocity.iter().map(Vector3::norm).sum::<f64>()
-                + r.angular_velocity.iter().map(|w| w.norm() * 2.0).sum::<f64>();
-            prop_assert!((after_n + e * r.normal_velocity).abs() <= 1e-12 * speed);
+            prop_assert!((after.dot(&n) + e * r.normal_velocity).abs() <= 1e-12 * speed);
+        }
+        // Sticking: the tangential solve (two conjugate-gradient steps for an anisotropic
+        // K_tt) leaves no tangential slip.
+        if r.outcome == Outcome::Applied(Friction::Sticking) {
+            let slip = after - n * n.dot(&after);
+            prop_assert!(slip.norm() <= 1e-11 * speed, "slip {} after sticking", slip.norm());
         }
     }
 
