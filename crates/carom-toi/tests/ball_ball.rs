@@ -60,13 +60,18 @@ fn touching_overlapping_receding_and_resting_follow_the_status_table() {
     let touching = ball2(1.0, 0.0, 0.5);
     let overlapping = ball2(0.9, 0.0, 0.5);
     let rest = Kinematics::at_rest();
-    let case = |b: &Ball<f64, 2>, v: (f64, f64)| ball_ball(&a, &rest, b, &moving(v.0, v.1), &forward());
+    let case =
+        |b: &Ball<f64, 2>, v: (f64, f64)| ball_ball(&a, &rest, b, &moving(v.0, v.1), &forward());
     let t = case(&touching, (-1.0, 0.0));
     assert_eq!((t.status, t.time), (Status::AlreadyTouching, 0.0));
     assert_eq!(t.point, Vector2::new(0.5, 0.0));
     assert_eq!(case(&touching, (1.0, 0.0)).status, Status::NoHit);
     assert_eq!(case(&touching, (0.0, 0.0)).status, Status::NoHit);
-    assert_eq!(case(&touching, (0.0, 1.0)).status, Status::NoHit, "tangential");
+    assert_eq!(
+        case(&touching, (0.0, 1.0)).status,
+        Status::NoHit,
+        "tangential"
+    );
     let o = case(&overlapping, (-1.0, 0.0));
     assert_eq!((o.status, o.time), (Status::AlreadyTouching, 0.0));
     assert_relative_eq!(o.point, Vector2::new(0.45, 0.0), max_relative = 1e-15);
@@ -142,7 +147,11 @@ fn huge_speeds_and_far_coordinates_keep_relative_accuracy() {
     );
     assert_eq!(far.time, base.time);
     assert_eq!(far.normal, base.normal);
-    assert_relative_eq!(far.point - Vector2::new(1e6, -1e6), base.point, epsilon = 1e-9);
+    assert_relative_eq!(
+        far.point - Vector2::new(1e6, -1e6),
+        base.point,
+        epsilon = 1e-9
+    );
 }
 
 #[test]
@@ -150,14 +159,38 @@ fn f32_handles_the_same_cases() {
     let b = |x: f32, y: f32| Ball::new(Vector3::new(x, y, 0.0), 0.5_f32).unwrap();
     let v = |x: f32| Kinematics::linear(Vector3::new(x, 0.0, 0.0)).unwrap();
     let w = Window::<f32>::unbounded(Direction::Forward);
-    let toi = ball_ball(&b(0.0, 0.0), &Kinematics::at_rest(), &b(3.0, 0.0), &v(-2.0), &w);
+    let toi = ball_ball(
+        &b(0.0, 0.0),
+        &Kinematics::at_rest(),
+        &b(3.0, 0.0),
+        &v(-2.0),
+        &w,
+    );
     assert_eq!((toi.status, toi.time), (Status::Hit, 1.0));
-    let graze = ball_ball(&b(0.0, 0.0), &Kinematics::at_rest(), &b(100.0, 1.001), &v(-1.0), &w);
+    let graze = ball_ball(
+        &b(0.0, 0.0),
+        &Kinematics::at_rest(),
+        &b(100.0, 1.001),
+        &v(-1.0),
+        &w,
+    );
     assert_eq!(graze.status, Status::NoHit);
-    let hit = ball_ball(&b(0.0, 0.0), &Kinematics::at_rest(), &b(100.0, 0.999), &v(-1.0), &w);
+    let hit = ball_ball(
+        &b(0.0, 0.0),
+        &Kinematics::at_rest(),
+        &b(100.0, 0.999),
+        &v(-1.0),
+        &w,
+    );
     let expected = 100.0 - ((1.0_f64 - 0.999_f32 as f64) * (1.0 + 0.999_f32 as f64)).sqrt();
     assert_relative_eq!(f64::from(hit.time), expected, max_relative = 1e-6);
-    let fast = ball_ball(&b(0.0, 0.0), &v(1e6), &b(1e3, 0.0), &Kinematics::at_rest(), &w);
+    let fast = ball_ball(
+        &b(0.0, 0.0),
+        &v(1e6),
+        &b(1e3, 0.0),
+        &Kinematics::at_rest(),
+        &w,
+    );
     assert_relative_eq!(fast.time, 999.0 / 1e6, max_relative = 1e-7);
 }
 
@@ -167,8 +200,17 @@ fn backward_finds_the_pair_that_recedes_forward() {
     let b = ball2(3.0, 0.0, 0.5);
     let away = moving(1.0, 0.0);
     let rest = Kinematics::at_rest();
-    assert_eq!(ball_ball(&a, &rest, &b, &away, &forward()).status, Status::NoHit);
-    let back = ball_ball(&a, &rest, &b, &away, &Window::unbounded(Direction::Backward));
+    assert_eq!(
+        ball_ball(&a, &rest, &b, &away, &forward()).status,
+        Status::NoHit
+    );
+    let back = ball_ball(
+        &a,
+        &rest,
+        &b,
+        &away,
+        &Window::unbounded(Direction::Backward),
+    );
     assert_eq!((back.status, back.time), (Status::Hit, -2.0));
     assert_eq!(back.normal, Vector2::new(1.0, 0.0));
     // At t = −2 ball 2 was at x = 1: the contact point is x = 0.5.
@@ -185,10 +227,24 @@ fn backward_finds_the_pair_that_recedes_forward() {
 #[test]
 fn horizon_cuts_far_events_and_keeps_the_one_at_the_horizon() {
     let args = (ball2(0.0, 0.0, 0.5), moving(1.0, 0.0), ball2(3.0, 0.0, 0.5));
-    let at = |h: f64| ball_ball(&args.0, &args.1, &args.2, &Kinematics::at_rest(), &Window::forward(h).unwrap());
+    let at = |h: f64| {
+        ball_ball(
+            &args.0,
+            &args.1,
+            &args.2,
+            &Kinematics::at_rest(),
+            &Window::forward(h).unwrap(),
+        )
+    };
     assert_eq!(at(1.999).status, Status::NoHit);
     assert_eq!(at(2.0).status, Status::Hit);
-    let back = ball_ball(&args.0, &args.1, &args.2, &Kinematics::at_rest(), &Window::backward(5.0).unwrap());
+    let back = ball_ball(
+        &args.0,
+        &args.1,
+        &args.2,
+        &Kinematics::at_rest(),
+        &Window::backward(5.0).unwrap(),
+    );
     assert_eq!(back.status, Status::NoHit);
 }
 

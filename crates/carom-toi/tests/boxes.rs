@@ -25,7 +25,13 @@ fn linear2(vx: f64, vy: f64) -> Kinematics<f64, 2> {
 #[test]
 fn face_contact_in_2d() {
     let ball = Ball::new(Vector2::new(-4.0, 0.3), 0.5).unwrap();
-    let toi = ball_aabb(&ball, &linear2(2.0, 0.0), &unit_square(), &Kinematics::at_rest(), &forward());
+    let toi = ball_aabb(
+        &ball,
+        &linear2(2.0, 0.0),
+        &unit_square(),
+        &Kinematics::at_rest(),
+        &forward(),
+    );
     assert_eq!((toi.status, toi.feature), (Status::Hit, BoxFeature::Face));
     assert_relative_eq!(toi.time, 1.25, max_relative = 1e-15);
     assert_eq!(toi.normal, Vector2::new(1.0, 0.0));
@@ -37,7 +43,13 @@ fn corner_contact_in_2d_is_the_rounded_corner_not_the_square() {
     // Moving along x at height 1.3: the expanded square (half size 1.5) would be hit at
     // x = −1.5, the rounded corner only at x = −1 − √(0.25 − 0.09) = −1.4.
     let ball = Ball::new(Vector2::new(-4.0, 1.3), 0.5).unwrap();
-    let toi = ball_aabb(&ball, &linear2(1.0, 0.0), &unit_square(), &Kinematics::at_rest(), &forward());
+    let toi = ball_aabb(
+        &ball,
+        &linear2(1.0, 0.0),
+        &unit_square(),
+        &Kinematics::at_rest(),
+        &forward(),
+    );
     assert_eq!((toi.status, toi.feature), (Status::Hit, BoxFeature::Corner));
     assert_relative_eq!(toi.time, 2.6, max_relative = 1e-14);
     assert_relative_eq!(toi.normal, Vector2::new(0.8, -0.6), max_relative = 1e-14);
@@ -45,11 +57,24 @@ fn corner_contact_in_2d_is_the_rounded_corner_not_the_square() {
     // Passing at height 1.5 + 1e-9 misses; at 1.5 − 1e-9 grazes the corner.
     let miss = Ball::new(Vector2::new(-4.0, 1.5 + 1e-9), 0.5).unwrap();
     assert_eq!(
-        ball_aabb(&miss, &linear2(1.0, 0.0), &unit_square(), &Kinematics::at_rest(), &forward()).status,
+        ball_aabb(
+            &miss,
+            &linear2(1.0, 0.0),
+            &unit_square(),
+            &Kinematics::at_rest(),
+            &forward()
+        )
+        .status,
         Status::NoHit
     );
     let graze = Ball::new(Vector2::new(-4.0, 1.5 - 1e-9), 0.5).unwrap();
-    let g = ball_aabb(&graze, &linear2(1.0, 0.0), &unit_square(), &Kinematics::at_rest(), &forward());
+    let g = ball_aabb(
+        &graze,
+        &linear2(1.0, 0.0),
+        &unit_square(),
+        &Kinematics::at_rest(),
+        &forward(),
+    );
     assert_eq!((g.status, g.feature), (Status::Hit, BoxFeature::Corner));
     let half_chord = ((0.5 - (0.5 - 1e-9)) * (0.5 + 0.5 - 1e-9_f64)).sqrt();
     assert_relative_eq!(g.time, 3.0 - half_chord, max_relative = 1e-12);
@@ -65,7 +90,11 @@ fn edge_and_corner_contacts_in_3d() {
     let toi = ball_aabb(&edge, &k, &cube, &rest, &forward());
     assert_eq!(toi.feature, BoxFeature::Edge);
     assert_relative_eq!(toi.time, 2.6, max_relative = 1e-14);
-    assert_relative_eq!(toi.point, Vector3::new(-1.0, 1.0, 0.0), max_relative = 1e-15);
+    assert_relative_eq!(
+        toi.point,
+        Vector3::new(-1.0, 1.0, 0.0),
+        max_relative = 1e-15
+    );
     // Along the diagonal towards the corner (1, 1, 1): contact at distance r from it.
     let d = Vector3::new(1.0, 1.0, 1.0) / 3f64.sqrt();
     let corner = Ball::new(Vector3::new(1.0, 1.0, 1.0) + d * 5.0, 0.5).unwrap();
@@ -81,12 +110,24 @@ fn ballistic_face_edge_and_corner() {
     let g = Vector2::new(0.0, -10.0);
     // Dropped from height 4 above the top face: 4 − 5t² = 1.5.
     let drop = Ball::new(Vector2::new(0.2, 4.0), 0.5).unwrap();
-    let toi = ball_aabb(&drop, &Kinematics::new(Vector2::zeros(), g).unwrap(), &unit_square(), &Kinematics::at_rest(), &forward());
+    let toi = ball_aabb(
+        &drop,
+        &Kinematics::new(Vector2::zeros(), g).unwrap(),
+        &unit_square(),
+        &Kinematics::at_rest(),
+        &forward(),
+    );
     assert_eq!(toi.feature, BoxFeature::Face);
     assert_relative_eq!(toi.time, 0.5_f64.sqrt(), max_relative = 1e-15);
     // Dropped just beside the corner: x = 1.3, falls onto the corner at y − 1 = 0.4.
     let beside = Ball::new(Vector2::new(1.3, 4.0), 0.5).unwrap();
-    let toi = ball_aabb(&beside, &Kinematics::new(Vector2::zeros(), g).unwrap(), &unit_square(), &Kinematics::at_rest(), &forward());
+    let toi = ball_aabb(
+        &beside,
+        &Kinematics::new(Vector2::zeros(), g).unwrap(),
+        &unit_square(),
+        &Kinematics::at_rest(),
+        &forward(),
+    );
     assert_eq!(toi.feature, BoxFeature::Corner);
     // 4 − 5t² = 1.4.
     assert_relative_eq!(toi.time, 0.52_f64.sqrt(), max_relative = 1e-14);
@@ -111,25 +152,56 @@ fn a_lob_rises_past_the_corner_and_lands_on_top() {
     assert_relative_eq!(toi.time, (8.0 + 40f64.sqrt()) / 10.0, max_relative = 1e-15);
     assert_eq!(toi.normal, Vector2::new(0.0, -1.0));
     // With a horizon before the landing: nothing, though it passes within 2 of the box.
-    let early = ball_aabb(&lob, &k, &unit_square(), &Kinematics::at_rest(), &Window::forward(1.4).unwrap());
+    let early = ball_aabb(
+        &lob,
+        &k,
+        &unit_square(),
+        &Kinematics::at_rest(),
+        &Window::forward(1.4).unwrap(),
+    );
     assert_eq!(early.status, Status::NoHit);
 }
 
 #[test]
 fn rotated_and_moving_boxes() {
     // A square rotated by 45°: its corner points along +x at distance √2.
-    let obb = Obb::from_angle(Vector2::zeros(), Vector2::new(1.0, 1.0), core::f64::consts::FRAC_PI_4).unwrap();
+    let obb = Obb::from_angle(
+        Vector2::zeros(),
+        Vector2::new(1.0, 1.0),
+        core::f64::consts::FRAC_PI_4,
+    )
+    .unwrap();
     let ball = Ball::new(Vector2::new(5.0, 0.0), 0.5).unwrap();
-    let toi = ball_obb(&ball, &linear2(-1.0, 0.0), &obb, &Kinematics::at_rest(), &forward());
+    let toi = ball_obb(
+        &ball,
+        &linear2(-1.0, 0.0),
+        &obb,
+        &Kinematics::at_rest(),
+        &forward(),
+    );
     assert_eq!(toi.feature, BoxFeature::Corner);
     assert_relative_eq!(toi.time, 5.0 - 0.5 - 2f64.sqrt(), max_relative = 1e-14);
-    assert_relative_eq!(toi.point, Vector2::new(2f64.sqrt(), 0.0), max_relative = 1e-14);
+    assert_relative_eq!(
+        toi.point,
+        Vector2::new(2f64.sqrt(), 0.0),
+        max_relative = 1e-14
+    );
     // The same box moving towards a ball at rest: relative motion is what counts, and the
     // point is on the box where it is at the time of contact.
     let still = Ball::new(Vector2::new(5.0, 0.0), 0.5).unwrap();
-    let toi2 = ball_obb(&still, &Kinematics::at_rest(), &obb, &linear2(1.0, 0.0), &forward());
+    let toi2 = ball_obb(
+        &still,
+        &Kinematics::at_rest(),
+        &obb,
+        &linear2(1.0, 0.0),
+        &forward(),
+    );
     assert_relative_eq!(toi2.time, toi.time, max_relative = 1e-15);
-    assert_relative_eq!(toi2.point, Vector2::new(2f64.sqrt() + toi.time, 0.0), max_relative = 1e-14);
+    assert_relative_eq!(
+        toi2.point,
+        Vector2::new(2f64.sqrt() + toi.time, 0.0),
+        max_relative = 1e-14
+    );
 }
 
 #[test]
@@ -137,17 +209,65 @@ fn starting_states() {
     let rest = Kinematics::at_rest();
     // Touching the face and approaching: immediate. Touching and leaving: none.
     let touching = Ball::new(Vector2::new(-1.5, 0.0), 0.5).unwrap();
-    let t = ball_aabb(&touching, &linear2(1.0, 0.0), &unit_square(), &rest, &forward());
-    assert_eq!((t.status, t.time, t.feature), (Status::AlreadyTouching, 0.0, BoxFeature::Face));
+    let t = ball_aabb(
+        &touching,
+        &linear2(1.0, 0.0),
+        &unit_square(),
+        &rest,
+        &forward(),
+    );
+    assert_eq!(
+        (t.status, t.time, t.feature),
+        (Status::AlreadyTouching, 0.0, BoxFeature::Face)
+    );
     assert_eq!(t.normal, Vector2::new(1.0, 0.0));
-    assert_eq!(ball_aabb(&touching, &linear2(-1.0, 0.0), &unit_square(), &rest, &forward()).status, Status::NoHit);
-    assert_eq!(ball_aabb(&touching, &linear2(0.0, 1.0), &unit_square(), &rest, &forward()).status, Status::NoHit);
+    assert_eq!(
+        ball_aabb(
+            &touching,
+            &linear2(-1.0, 0.0),
+            &unit_square(),
+            &rest,
+            &forward()
+        )
+        .status,
+        Status::NoHit
+    );
+    assert_eq!(
+        ball_aabb(
+            &touching,
+            &linear2(0.0, 1.0),
+            &unit_square(),
+            &rest,
+            &forward()
+        )
+        .status,
+        Status::NoHit
+    );
     // Centre inside the box: the nearest face decides.
     let inside = Ball::new(Vector2::new(0.8, 0.1), 0.5).unwrap();
-    let i = ball_aabb(&inside, &linear2(-1.0, 0.0), &unit_square(), &rest, &forward());
-    assert_eq!((i.status, i.feature), (Status::AlreadyTouching, BoxFeature::Inside));
+    let i = ball_aabb(
+        &inside,
+        &linear2(-1.0, 0.0),
+        &unit_square(),
+        &rest,
+        &forward(),
+    );
+    assert_eq!(
+        (i.status, i.feature),
+        (Status::AlreadyTouching, BoxFeature::Inside)
+    );
     assert_eq!(i.normal, Vector2::new(-1.0, 0.0));
-    assert_eq!(ball_aabb(&inside, &linear2(1.0, 0.0), &unit_square(), &rest, &forward()).status, Status::NoHit);
+    assert_eq!(
+        ball_aabb(
+            &inside,
+            &linear2(1.0, 0.0),
+            &unit_square(),
+            &rest,
+            &forward()
+        )
+        .status,
+        Status::NoHit
+    );
     // Overlapping the top and leaving upward under gravity: it separates (up to 1.75),
     // then falls back onto the face: −0.2 + 3t − 5t² = 0, the descending root.
     let leaving = Ball::new(Vector2::new(0.0, 1.3), 0.5).unwrap();
@@ -160,7 +280,10 @@ fn starting_states() {
     // Exactly representable: gap −0.25 + 2t − 4t² peaks at 0.
     let sunk = Ball::new(Vector2::new(0.0, 1.25), 0.5).unwrap();
     let tangent = Kinematics::new(Vector2::new(0.0, 2.0), Vector2::new(0.0, -8.0)).unwrap();
-    assert_eq!(ball_aabb(&sunk, &tangent, &unit_square(), &rest, &forward()).status, Status::NoHit);
+    assert_eq!(
+        ball_aabb(&sunk, &tangent, &unit_square(), &rest, &forward()).status,
+        Status::NoHit
+    );
 }
 
 #[test]
@@ -168,7 +291,13 @@ fn backward_and_f32() {
     let ball = Ball::new(Vector2::new(-4.0_f32, 0.3), 0.5).unwrap();
     let away = Kinematics::linear(Vector2::new(-2.0_f32, 0.0)).unwrap();
     let sq = Aabb::new(Vector2::new(-1.0_f32, -1.0), Vector2::new(1.0, 1.0)).unwrap();
-    let b = ball_aabb(&ball, &away, &sq, &Kinematics::at_rest(), &Window::backward(10.0).unwrap());
+    let b = ball_aabb(
+        &ball,
+        &away,
+        &sq,
+        &Kinematics::at_rest(),
+        &Window::backward(10.0).unwrap(),
+    );
     assert_eq!((b.status, b.time), (Status::Hit, -1.25));
     assert_eq!(b.normal, Vector2::new(1.0, 0.0));
 }

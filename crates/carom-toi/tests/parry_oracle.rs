@@ -31,7 +31,10 @@ fn agree(ours: f32, theirs: Option<f32>, robust: bool) -> Result<(), TestCaseErr
         return Ok(());
     }
     match theirs {
-        Some(t) => prop_assert!((ours - t).abs() <= 1e-3 * (1.0 + t), "carom {ours} vs parry {t}"),
+        Some(t) => prop_assert!(
+            (ours - t).abs() <= 1e-3 * (1.0 + t),
+            "carom {ours} vs parry {t}"
+        ),
         None => prop_assert!(ours.is_infinite(), "carom {ours} vs parry none"),
     }
     Ok(())

@@ -30,7 +30,11 @@ fn ball_falls_on_a_floor_even_when_thrown_up() {
     assert_eq!(toi.status, Status::Hit);
     assert_relative_eq!(toi.time, expected, max_relative = 1e-15);
     assert_eq!(toi.normal, Vector2::new(0.0, -1.0));
-    assert_relative_eq!(toi.point, Vector2::new(1.0 + 0.5 * expected, 0.0), epsilon = 1e-15);
+    assert_relative_eq!(
+        toi.point,
+        Vector2::new(1.0 + 0.5 * expected, 0.0),
+        epsilon = 1e-15
+    );
 }
 
 #[test]
@@ -47,7 +51,11 @@ fn plane_statuses_linear() {
     assert_eq!(at(2.5, 4.0).status, Status::NoHit);
     assert_eq!(at(0.5, 0.0).status, Status::NoHit, "resting on the floor");
     assert_eq!(at(0.5, -1.0).status, Status::AlreadyTouching);
-    assert_eq!(at(0.2, -1.0).status, Status::AlreadyTouching, "sunk and sinking");
+    assert_eq!(
+        at(0.2, -1.0).status,
+        Status::AlreadyTouching,
+        "sunk and sinking"
+    );
     assert_eq!(at(0.2, 1.0).status, Status::NoHit, "sunk and leaving");
     // Backward: a ball rising now was lower before.
     let b = ball_plane(
@@ -63,10 +71,16 @@ fn plane_statuses_linear() {
 fn a_sunk_ball_at_rest_under_gravity_is_caught_not_lost() {
     let ball = Ball::new(Vector2::new(0.0, 0.4), 0.5).unwrap();
     let k = Kinematics::new(Vector2::zeros(), Vector2::new(0.0, -9.81)).unwrap();
-    assert_eq!(ball_plane(&ball, &k, &floor(), &forward()).status, Status::AlreadyTouching);
+    assert_eq!(
+        ball_plane(&ball, &k, &floor(), &forward()).status,
+        Status::AlreadyTouching
+    );
     // Touching exactly at rest under gravity is resting contact: not an event.
     let resting = Ball::new(Vector2::new(0.0, 0.5), 0.5).unwrap();
-    assert_eq!(ball_plane(&resting, &k, &floor(), &forward()).status, Status::NoHit);
+    assert_eq!(
+        ball_plane(&resting, &k, &floor(), &forward()).status,
+        Status::NoHit
+    );
 }
 
 fn room() -> Border<f64, 2> {
@@ -76,15 +90,41 @@ fn room() -> Border<f64, 2> {
 #[test]
 fn first_wall_per_axis() {
     let ball = Ball::new(Vector2::new(1.0, 1.0), 0.25).unwrap();
-    let toi = ball_border(&ball, &Kinematics::linear(Vector2::new(2.0, 0.5)).unwrap(), &room(), &forward());
+    let toi = ball_border(
+        &ball,
+        &Kinematics::linear(Vector2::new(2.0, 0.5)).unwrap(),
+        &room(),
+        &forward(),
+    );
     // x reaches 3.75 at t = 1.375; y reaches 1.75 at t = 1.5.
     assert_eq!(toi.status, Status::Hit);
     assert_relative_eq!(toi.time, 1.375, max_relative = 1e-15);
-    assert_eq!(toi.feature, Wall { axis: 0, side: Side::Upper });
+    assert_eq!(
+        toi.feature,
+        Wall {
+            axis: 0,
+            side: Side::Upper
+        }
+    );
     assert_eq!(toi.normal, Vector2::new(1.0, 0.0));
-    assert_relative_eq!(toi.point, Vector2::new(4.0, 1.0 + 0.5 * 1.375), max_relative = 1e-15);
-    let left = ball_border(&ball, &Kinematics::linear(Vector2::new(-1.0, 0.1)).unwrap(), &room(), &forward());
-    assert_eq!(left.feature, Wall { axis: 0, side: Side::Lower });
+    assert_relative_eq!(
+        toi.point,
+        Vector2::new(4.0, 1.0 + 0.5 * 1.375),
+        max_relative = 1e-15
+    );
+    let left = ball_border(
+        &ball,
+        &Kinematics::linear(Vector2::new(-1.0, 0.1)).unwrap(),
+        &room(),
+        &forward(),
+    );
+    assert_eq!(
+        left.feature,
+        Wall {
+            axis: 0,
+            side: Side::Lower
+        }
+    );
     assert_relative_eq!(left.time, 0.75, max_relative = 1e-15);
     assert_eq!(left.normal, Vector2::new(-1.0, 0.0));
 }
@@ -94,14 +134,26 @@ fn under_gravity_a_rising_ball_hits_the_floor() {
     let ball = Ball::new(Vector2::new(2.0, 1.0), 0.25).unwrap();
     let k = Kinematics::new(Vector2::new(0.0, 1.0), Vector2::new(0.0, -9.81)).unwrap();
     let toi = ball_border(&ball, &k, &room(), &forward());
-    assert_eq!(toi.feature, Wall { axis: 1, side: Side::Lower });
+    assert_eq!(
+        toi.feature,
+        Wall {
+            axis: 1,
+            side: Side::Lower
+        }
+    );
     // 0.75 + t − 4.905 t² = 0.
     let expected = (1.0 + (1.0 + 4.0 * 4.905 * 0.75_f64).sqrt()) / (2.0 * 4.905);
     assert_relative_eq!(toi.time, expected, max_relative = 1e-15);
     // Thrown hard enough, it reaches the ceiling first: 0.75 + 6t − 4.905t² = 0 ... ceiling gap 0.75 − 6t + 4.905t².
     let up = Kinematics::new(Vector2::new(0.0, 6.0), Vector2::new(0.0, -9.81)).unwrap();
     let hit = ball_border(&ball, &up, &room(), &forward());
-    assert_eq!(hit.feature, Wall { axis: 1, side: Side::Upper });
+    assert_eq!(
+        hit.feature,
+        Wall {
+            axis: 1,
+            side: Side::Upper
+        }
+    );
     let ceiling = (6.0 - (36.0 - 4.0 * 4.905 * 0.75_f64).sqrt()) / (2.0 * 4.905);
     assert_relative_eq!(hit.time, ceiling, max_relative = 1e-14);
 }
@@ -110,27 +162,70 @@ fn under_gravity_a_rising_ball_hits_the_floor() {
 fn a_ball_partly_outside_cannot_escape() {
     // Half out through the right wall, still moving out: reflect it now.
     let ball = Ball::new(Vector2::new(4.0, 1.0), 0.25).unwrap();
-    let out = ball_border(&ball, &Kinematics::linear(Vector2::new(1.0, 0.0)).unwrap(), &room(), &forward());
+    let out = ball_border(
+        &ball,
+        &Kinematics::linear(Vector2::new(1.0, 0.0)).unwrap(),
+        &room(),
+        &forward(),
+    );
     assert_eq!((out.status, out.time), (Status::AlreadyTouching, 0.0));
-    assert_eq!(out.feature, Wall { axis: 0, side: Side::Upper });
+    assert_eq!(
+        out.feature,
+        Wall {
+            axis: 0,
+            side: Side::Upper
+        }
+    );
     // Coming back in: the next event is the far wall.
-    let back = ball_border(&ball, &Kinematics::linear(Vector2::new(-1.0, 0.0)).unwrap(), &room(), &forward());
-    assert_eq!(back.feature, Wall { axis: 0, side: Side::Lower });
+    let back = ball_border(
+        &ball,
+        &Kinematics::linear(Vector2::new(-1.0, 0.0)).unwrap(),
+        &room(),
+        &forward(),
+    );
+    assert_eq!(
+        back.feature,
+        Wall {
+            axis: 0,
+            side: Side::Lower
+        }
+    );
     assert_relative_eq!(back.time, 3.75, max_relative = 1e-15);
     // Wholly outside beyond a corner, moving further out on both axes: the deeper wall.
     let far = Ball::new(Vector2::new(5.0, 2.5), 0.25).unwrap();
-    let t = ball_border(&far, &Kinematics::linear(Vector2::new(1.0, 1.0)).unwrap(), &room(), &forward());
+    let t = ball_border(
+        &far,
+        &Kinematics::linear(Vector2::new(1.0, 1.0)).unwrap(),
+        &room(),
+        &forward(),
+    );
     assert_eq!(t.status, Status::AlreadyTouching);
-    assert_eq!(t.feature, Wall { axis: 0, side: Side::Upper });
+    assert_eq!(
+        t.feature,
+        Wall {
+            axis: 0,
+            side: Side::Upper
+        }
+    );
 }
 
 #[test]
 fn border_in_3d_and_f32() {
-    let border = Border::new(Vector3::new(-1.0_f32, -1.0, -1.0), Vector3::new(1.0, 1.0, 1.0)).unwrap();
+    let border = Border::new(
+        Vector3::new(-1.0_f32, -1.0, -1.0),
+        Vector3::new(1.0, 1.0, 1.0),
+    )
+    .unwrap();
     let ball = Ball::new(Vector3::new(0.0_f32, 0.0, 0.0), 0.5).unwrap();
     let k = Kinematics::linear(Vector3::new(0.1_f32, 0.2, -1.0)).unwrap();
     let toi = ball_border(&ball, &k, &border, &Window::unbounded(Direction::Forward));
-    assert_eq!(toi.feature, Wall { axis: 2, side: Side::Lower });
+    assert_eq!(
+        toi.feature,
+        Wall {
+            axis: 2,
+            side: Side::Lower
+        }
+    );
     assert_eq!(toi.time, 0.5);
     assert_eq!(toi.normal, Vector3::new(0.0, 0.0, -1.0));
 }
@@ -143,7 +238,10 @@ fn level_and_plane_crossings() {
     assert_eq!((c.status, c.to), (Status::Hit, Side::Upper));
     assert_relative_eq!(c.time, 0.4, max_relative = 1e-15);
     // Moving away: none. On the level and moving up: belongs to the upper side, no crossing.
-    assert_eq!(level_crossing(0.2, -2.0, 0.0, 1.0, &w).status, Status::NoHit);
+    assert_eq!(
+        level_crossing(0.2, -2.0, 0.0, 1.0, &w).status,
+        Status::NoHit
+    );
     assert_eq!(level_crossing(1.0, 2.0, 0.0, 1.0, &w).status, Status::NoHit);
     // Ballistic: on the level moving up, it falls back through it at t = 2v/g.
     let c = level_crossing(1.0, 2.0, -10.0, 1.0, &w);
@@ -155,7 +253,10 @@ fn level_and_plane_crossings() {
     assert_relative_eq!(b.time, -0.4, max_relative = 1e-15);
     // At rest on the level: never. Non-finite input: not converged, never a panic.
     assert_eq!(level_crossing(1.0, 0.0, 0.0, 1.0, &w).status, Status::NoHit);
-    assert_eq!(level_crossing(f64::NAN, 1.0, 0.0, 1.0, &w).status, Status::NotConverged);
+    assert_eq!(
+        level_crossing(f64::NAN, 1.0, 0.0, 1.0, &w).status,
+        Status::NotConverged
+    );
     // A plane through (0, 1) with normal (0, 1): a centre at height 3 falling at 4.
     let plane = HalfSpace::new(Vector2::new(0.0, 2.0), Vector2::new(0.0, 1.0)).unwrap();
     let k = Kinematics::linear(Vector2::new(1.0, -4.0)).unwrap();
