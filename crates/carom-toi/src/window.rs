@@ -114,7 +114,7 @@ impl<T: Real> Window<T> {
     /// A forward search time `s >= 0` as the signed time reported to the caller.
     #[inline]
     pub(crate) fn signed(&self, s: T) -> T {
-        s * self.direction.sign()
+        s * self.direction.sign() + T::zero()
     }
 }
 

@@ -182,7 +182,7 @@ fn f32_handles_the_same_cases() {
         &v(-1.0),
         &w,
     );
-    let expected = 100.0 - ((1.0_f64 - 0.999_f32 as f64) * (1.0 + 0.999_f32 as f64)).sqrt();
+    let expected = 100.0 - ((1.0_f64 - f64::from(0.999_f32)) * (1.0 + f64::from(0.999_f32))).sqrt();
     assert_relative_eq!(f64::from(hit.time), expected, max_relative = 1e-6);
     let fast = ball_ball(
         &b(0.0, 0.0),

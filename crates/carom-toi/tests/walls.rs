@@ -285,12 +285,11 @@ proptest! {
         };
         let toi = ball_border(&ball, &k, &room(), &Window::forward(horizon).unwrap());
         let brute = common::brute_first_descent(gap, horizon, 40_000);
-        match brute {
-            Some(tb) => {
-                prop_assert_eq!(toi.status, Status::Hit);
-                prop_assert!((toi.time - tb).abs() < 1e-9, "{} vs {}", toi.time, tb);
-            }
-            None => prop_assert_eq!(toi.status, Status::NoHit),
+        if let Some(tb) = brute {
+            prop_assert_eq!(toi.status, Status::Hit);
+            prop_assert!((toi.time - tb).abs() < 1e-9, "{} vs {}", toi.time, tb);
+        } else {
+            prop_assert_eq!(toi.status, Status::NoHit);
         }
     }
 }

@@ -323,7 +323,7 @@ fn refine<T: Real, const D: usize, C: Components<T, D>>(
     let at = |s: T| armed_minimum(set, armed, n, &set.state(s));
     let (g_lo, _) = at(lo);
     let (g_hi, k_hi) = at(hi);
-    if g_hi == T::zero() || !(g_lo > T::zero()) {
+    if g_hi == T::zero() || g_lo <= T::zero() || crate::roots::is_nan(g_lo) {
         return Advance::At(if g_hi == T::zero() { hi } else { lo }, k_hi);
     }
     if crate::roots::is_nan(g_hi) {

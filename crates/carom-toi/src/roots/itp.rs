@@ -18,7 +18,7 @@ use carom_math::Real;
 
 /// The most evaluations one call makes, whatever the input: ITP reaches `4 ε_mach |b|` in
 /// at most 60 (f64), and bisection from there to a root `2^k` times smaller takes `k` more.
-const MAX_EVALUATIONS: usize = 400;
+const MAX_EVALUATIONS: i32 = 400;
 
 /// Narrows `[a, b]`, where `fa = f(a)` and `fb = f(b)` are non-zero with opposite signs,
 /// around a sign change of `f`. Returns `(x_a, x_b)`: the final bracket, `x_a` on the side
@@ -39,8 +39,7 @@ pub(crate) fn itp<T: Real>(mut f: impl FnMut(T) -> T, a: T, b: T, fa: T, fb: T, 
         .to_f64() as i32
         + 1;
     let kappa1 = T::lit(0.2) / (hi - lo);
-    let mut j = 0_i32;
-    for _ in 0..MAX_EVALUATIONS {
+    for j in 0..MAX_EVALUATIONS {
         let width = hi - lo;
         if width <= goal(lo, hi) {
             break;
@@ -86,7 +85,6 @@ pub(crate) fn itp<T: Real>(mut f: impl FnMut(T) -> T, a: T, b: T, fa: T, fb: T, 
         } else {
             return (x, x);
         }
-        j += 1;
     }
     (lo, hi)
 }

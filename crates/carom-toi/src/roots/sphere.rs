@@ -146,7 +146,7 @@ impl<T: Real, const D: usize> SphereGap<T, D> {
             Descent::Clear { armed } => Descent::Clear {
                 armed: armed || end < hi,
             },
-            at => at,
+            at @ Descent::At(_) => at,
         })
     }
 }
