@@ -413,3 +413,27 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_spinning_cluster_moving_away_is_no_hit_even_without_a_horizon() {
+    let c = dumbbell(1.0, 0.2);
+    let m = spin2(0.0, Vector2::new(-1.0, 0.3), 7.0);
+    let toi = cluster_plane(
+        &c,
+        &m,
+        &right_wall(1.5),
+        &Window::unbounded(carom_toi::Direction::Forward),
+        &options(&c),
+    );
+    assert_eq!(toi.status, Status::NoHit);
+    let other = Ball::new(Vector2::new(3.0, 0.0), 0.5).unwrap();
+    let away = cluster_ball(
+        &c,
+        &m,
+        &other,
+        &Kinematics::linear(Vector2::new(1.0, 0.0)).unwrap(),
+        &Window::unbounded(carom_toi::Direction::Forward),
+        &options(&c),
+    );
+    assert_eq!(away.status, Status::NoHit);
+}

@@ -120,6 +120,10 @@ pub(crate) trait Components<T: Real, const D: usize> {
     fn sample(&self, state: &Self::State, k: usize) -> Sample<T>;
     /// Component `k`'s bounds over the search times between `s0` and `s1`.
     fn bounds(&self, k: usize, s0: T, s1: T) -> Bounds<T>;
+    /// `true` if component `k` provably never touches after search time `s` (so an
+    /// unbounded search can stop): its reference points move apart without acceleration
+    /// and are farther apart than the balls can reach.
+    fn separating_for_good(&self, state: &Self::State, k: usize, s: T) -> bool;
     /// Component `k`'s unit normal (first body to second) and contact point in `state`.
     fn contact(&self, state: &Self::State, k: usize) -> (Vector<T, D>, Vector<T, D>);
 }
@@ -202,6 +206,7 @@ pub(crate) fn advance<T: Real, const D: usize, C: Components<T, D>>(
     for _ in 0..options.max_steps {
         let mut step = T::INFINITY;
         let mut closest: Option<(Sample<T>, usize)> = None;
+        let mut all_separating = true;
         for k in 0..n {
             let x = set.sample(&state, k);
             if !(x.gap.finite() && x.rate.finite()) {
@@ -222,6 +227,7 @@ pub(crate) fn advance<T: Real, const D: usize, C: Components<T, D>>(
                 closest = Some((x, k));
             }
             step = step.min(safe_step(set, k, s, x, armed.get(k), delta));
+            all_separating = all_separating && set.separating_for_good(&state, k, s);
         }
         if let Some((x, k)) = closest {
             // Within δ and closing: the upper parabola says when the gap is surely < 0.
@@ -237,7 +243,7 @@ pub(crate) fn advance<T: Real, const D: usize, C: Components<T, D>>(
                 return refine(set, &armed, n, s, probe, delta);
             }
         }
-        if step == T::INFINITY || s + step > horizon {
+        if all_separating || step == T::INFINITY || s + step > horizon {
             return Advance::Clear;
         }
         let next = s + step;

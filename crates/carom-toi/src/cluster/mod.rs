@@ -155,6 +155,16 @@ impl<T: Real, const D: usize, M: RigidMotion<T, D>> Components<T, D> for PlaneSe
         }
     }
 
+    fn separating_for_good(&self, state: &RigidState<T, D>, k: usize, s: T) -> bool {
+        let (ball, (n, offset)) = (
+            &self.balls[k / self.planes.len()],
+            &self.planes[k % self.planes.len()],
+        );
+        self.motion.acceleration_bound(T::zero(), s, T::MAX) == T::zero()
+            && n.dot(&state.velocity) >= T::zero()
+            && n.dot(&state.position) - *offset - ball.reach - ball.radius > T::zero()
+    }
+
     fn contact(&self, state: &RigidState<T, D>, k: usize) -> (Vector<T, D>, Vector<T, D>) {
         let (ball, (n, offset)) = (
             &self.balls[k / self.planes.len()],
@@ -224,6 +234,15 @@ impl<T: Real, const D: usize, M1: RigidMotion<T, D>, M2: RigidMotion<T, D>> Comp
             curvature_apart: acceleration + speed * speed / (a.radius + b.radius),
             curvature_any: T::INFINITY,
         }
+    }
+
+    fn separating_for_good(&self, (s1, s2): &Self::State, k: usize, s: T) -> bool {
+        let (a, b) = self.pair(k);
+        let d = s2.position - s1.position;
+        self.motion1.acceleration_bound(T::zero(), s, T::MAX) == T::zero()
+            && self.motion2.acceleration_bound(T::zero(), s, T::MAX) == T::zero()
+            && d.dot(&(s2.velocity - s1.velocity)) >= T::zero()
+            && d.norm() - (a.reach + b.reach + a.radius + b.radius) > T::zero()
     }
 
     fn contact(&self, (s1, s2): &Self::State, k: usize) -> (Vector<T, D>, Vector<T, D>) {

@@ -33,15 +33,17 @@ pub(crate) struct Quadratic<T: Real> {
 }
 
 impl<T: Real> Quadratic<T> {
-    /// The quadratic `a t² + 2 h t + c`, its discriminant by Kahan's algorithm.
+    /// The quadratic `a t² + 2 h t + c`, its discriminant by Kahan's algorithm (`h²`
+    /// exactly rounded when `a = 0`: a linear gap has nothing to cancel, and skipping the
+    /// fused multiply-adds matters where the target has no hardware FMA).
     #[inline]
     pub(crate) fn new(a: T, h: T, c: T) -> Self {
-        Self {
-            a,
-            h,
-            c,
-            disc: diff_of_products(h, h, a, c),
-        }
+        let disc = if a == T::zero() {
+            h * h
+        } else {
+            diff_of_products(h, h, a, c)
+        };
+        Self { a, h, c, disc }
     }
 
     /// The quadratic with a discriminant the caller computed more accurately.
