@@ -78,11 +78,22 @@ pub fn ball_ball<T: Real, const D: usize>(
             feature: (),
         }
     };
-    if gap.closing_at_start() {
-        return contact(Status::AlreadyTouching, T::zero());
-    }
-    let armed = gap.gap(T::zero()) > T::zero();
-    match gap.first_descent(T::zero(), window.horizon(), armed) {
+    let descent = if gap.is_linear() {
+        // Receding pairs leave before any square root; a closing pair in contact has a
+        // descending root <= 0 and is immediate.
+        match gap.linear_first_contact(window.horizon()) {
+            Some(Descent::At(s)) if s == T::zero() || gap.gap(T::zero()) <= T::zero() => {
+                return contact(Status::AlreadyTouching, T::zero());
+            }
+            other => other,
+        }
+    } else {
+        if gap.closing_at_start() {
+            return contact(Status::AlreadyTouching, T::zero());
+        }
+        gap.first_descent(T::zero(), window.horizon(), gap.gap(T::zero()) > T::zero())
+    };
+    match descent {
         Some(Descent::At(s)) => contact(Status::Hit, s),
         Some(Descent::Clear { .. }) => Toi::no_hit(window.direction().sign(), ()),
         None => Toi::not_converged(T::zero(), ()),

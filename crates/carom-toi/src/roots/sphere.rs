@@ -83,12 +83,37 @@ impl<T: Real, const D: usize> SphereGap<T, D> {
 
     /// The first descent on `[lo, hi]` (`hi` may be `+∞`); `None` if a value overflowed.
     pub(crate) fn first_descent(&self, lo: T, hi: T, armed: bool) -> Option<Descent<T>> {
-        if self.half_acceleration.iter().all(|&x| x == T::zero()) {
+        if self.is_linear() {
             let q = self.linear_quadratic();
             q.is_finite().then(|| q.first_descent(lo, hi, armed))
         } else {
             self.quartic_first_descent(lo, hi, armed)
         }
+    }
+
+    /// `true` if the relative acceleration is zero.
+    #[inline]
+    pub(crate) fn is_linear(&self) -> bool {
+        self.half_acceleration.iter().all(|&x| x == T::zero())
+    }
+
+    /// Linear motion, starting apart or not: the closed form with early exits (no square
+    /// root for a receding pair, which is half of all pairs). `None` on overflow.
+    #[inline]
+    pub(crate) fn linear_first_contact(&self, hi: T) -> Option<Descent<T>> {
+        debug_assert!(self.is_linear());
+        // A linear |u|² is convex: once it is not decreasing it never closes again.
+        if self.u0.dot(&self.w) >= T::zero() {
+            return Some(Descent::Clear { armed: true });
+        }
+        let q = self.linear_quadratic();
+        if !q.is_finite() {
+            return None;
+        }
+        Some(match q.descending_root() {
+            Some(s) if s <= hi => Descent::At(s.max(T::zero())),
+            _ => Descent::Clear { armed: true },
+        })
     }
 
     /// `|u₀ + w t|² − r²` with the accurate constant term and discriminant (module docs).
