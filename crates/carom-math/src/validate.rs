@@ -41,6 +41,8 @@ pub enum Problem {
     },
     /// A set that must not be empty was empty.
     Empty,
+    /// A matrix (an inertia tensor) that must be symmetric positive definite is not.
+    NotPositiveDefinite,
 }
 
 impl fmt::Display for Problem {
@@ -57,6 +59,7 @@ impl fmt::Display for Problem {
                 write!(f, "lower bound {min} exceeds upper bound {max}")
             }
             Problem::Empty => write!(f, "must not be empty"),
+            Problem::NotPositiveDefinite => write!(f, "must be symmetric positive definite"),
         }
     }
 }

@@ -1,0 +1,212 @@
+//! Quadratic gap functions `f(t) = a t² + 2 h t + c` and their unique descending root.
+//!
+//! Derivation. The real roots are `t = (−h ± √Δ)/a` with `Δ = h² − a c`, and
+//! `f'(t) = 2(a t + h) = ±2√Δ` there: exactly one root is *descending* (`f' < 0`, the gap
+//! closing), `t↓ = (−h − √Δ)/a`, whatever the sign of `a`. Multiplying by
+//! `(−h + √Δ)/(−h + √Δ)` and using `h² − Δ = a c` gives the second form
+//!
+//! ```text
+//! t↓ = c / (−h + √Δ)        (used when h < 0: both terms of the denominator positive)
+//! t↓ = (−h − √Δ) / a        (used when h ≥ 0: both terms of the numerator non-positive)
+//! ```
+//!
+//! so neither form subtracts nearly equal numbers (no cancellation), and `a = 0` (a
+//! linear gap `2 h t + c`) is the first form with `√Δ = |h|`. `Δ` itself is computed with
+//! Kahan's difference of products, or supplied by the caller when a better formula is
+//! known (the miss distance of two balls). `Δ <= 0` means a tangency or no real root:
+//! no descending crossing.
+//!
+//! A quadratic has at most one descending root, so its first descent on an interval is
+//! that root if it lies inside.
+
+use carom_math::{Real, robust::diff_of_products};
+
+use super::Descent;
+
+/// `f(t) = a t² + 2 h t + c` with its discriminant `Δ = h² − a c`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Quadratic<T: Real> {
+    a: T,
+    h: T,
+    c: T,
+    disc: T,
+}
+
+impl<T: Real> Quadratic<T> {
+    /// The quadratic `a t² + 2 h t + c`, its discriminant by Kahan's algorithm (`h²`
+    /// exactly rounded when `a = 0`: a linear gap has nothing to cancel, and skipping the
+    /// fused multiply-adds matters where the target has no hardware FMA).
+    #[inline]
+    pub(crate) fn new(a: T, h: T, c: T) -> Self {
+        let disc = if a == T::zero() {
+            h * h
+        } else {
+            diff_of_products(h, h, a, c)
+        };
+        Self { a, h, c, disc }
+    }
+
+    /// The quadratic with a discriminant the caller computed more accurately.
+    #[inline]
+    pub(crate) fn with_discriminant(a: T, h: T, c: T, disc: T) -> Self {
+        Self { a, h, c, disc }
+    }
+
+    /// The value at `t`.
+    #[inline]
+    pub(crate) fn eval(&self, t: T) -> T {
+        (self.a * t + self.h * T::lit(2.0)) * t + self.c
+    }
+
+    /// The derivative at `t`.
+    #[inline]
+    pub(crate) fn rate(&self, t: T) -> T {
+        (self.a * t + self.h) * T::lit(2.0)
+    }
+
+    /// `true` if every coefficient is finite (no overflow while forming them).
+    #[inline]
+    pub(crate) fn is_finite(&self) -> bool {
+        self.a.finite() && self.h.finite() && self.c.finite() && self.disc.finite()
+    }
+
+    /// The root where the function crosses zero downwards, if there is one.
+    #[inline]
+    pub(crate) fn descending_root(&self) -> Option<T> {
+        if self.disc <= T::zero() {
+            return None;
+        }
+        let sqrt_disc = self.disc.sqrt();
+        if self.h < T::zero() {
+            Some(self.c / (sqrt_disc - self.h))
+        } else if self.a != T::zero() {
+            Some((-self.h - sqrt_disc) / self.a)
+        } else {
+            None
+        }
+    }
+
+    /// The real roots in increasing order (a double root once), and how many there are.
+    pub(crate) fn roots(&self) -> ([T; 2], usize) {
+        let (a, h, c) = (self.a, self.h, self.c);
+        if a == T::zero() {
+            return if h == T::zero() {
+                ([T::zero(); 2], 0)
+            } else {
+                ([-c / (h * T::lit(2.0)), T::zero()], 1)
+            };
+        }
+        if self.disc < T::zero() {
+            return ([T::zero(); 2], 0);
+        }
+        if self.disc == T::zero() {
+            return ([-h / a, T::zero()], 1);
+        }
+        // q = −(h + sign(h)√Δ) has no cancellation; the roots are q/a and c/q.
+        let q = -(h + h.copysign_one() * self.disc.sqrt());
+        let (r1, r2) = (q / a, c / q);
+        if r1 <= r2 {
+            ([r1, r2], 2)
+        } else {
+            ([r2, r1], 2)
+        }
+    }
+
+    /// The first time in `[lo, hi]` (`hi` may be `+∞`) at which the function goes from
+    /// positive to negative, given whether it was already positive before `lo`.
+    ///
+    /// The descending root `t↓` counts if `lo < t↓ <= hi` (the function is positive just
+    /// before it), or `t↓ = lo` when already armed. Rounding at interval ends (the end of
+    /// one region of a piecewise gap is the start of the next) is absorbed: an armed
+    /// function that is already negative and decreasing at `lo` descends at `lo`.
+    pub(crate) fn first_descent(&self, lo: T, hi: T, armed: bool) -> Descent<T> {
+        if let Some(root) = self.descending_root()
+            && (root > lo || (armed && root == lo))
+            && root <= hi
+        {
+            return Descent::At(root);
+        }
+        let at_lo = self.eval(lo);
+        if armed && at_lo < T::zero() && self.rate(lo) < T::zero() {
+            return Descent::At(lo);
+        }
+        Descent::Clear {
+            armed: armed || at_lo > T::zero() || self.max_after(lo, hi) > T::zero(),
+        }
+    }
+
+    /// The largest value on `(lo, hi]` (`+∞` if it grows without bound), at the end or at
+    /// the vertex.
+    fn max_after(&self, lo: T, hi: T) -> T {
+        let at_end = if hi.finite() {
+            self.eval(hi)
+        } else if self.a > T::zero() || (self.a == T::zero() && self.h > T::zero()) {
+            T::INFINITY
+        } else {
+            -T::INFINITY
+        };
+        if self.a < T::zero() {
+            let vertex = -self.h / self.a;
+            if vertex > lo && vertex < hi {
+                return at_end.max(self.eval(vertex));
+            }
+        }
+        at_end
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn descending_root_of_both_signs_of_curvature() {
+        // (t − 1)(t − 3): descends at 1.
+        let q = Quadratic::new(1.0, -2.0, 3.0);
+        assert_eq!(q.descending_root(), Some(1.0));
+        // −(t − 1)(t − 3): descends at 3.
+        let q = Quadratic::new(-1.0, 2.0, -3.0);
+        assert_eq!(q.descending_root(), Some(3.0));
+        // Linear 2 − t (h = −1/2).
+        assert_eq!(Quadratic::new(0.0, -0.5, 2.0).descending_root(), Some(2.0));
+        // Increasing line: none.
+        assert_eq!(Quadratic::new(0.0, 0.5, 2.0).descending_root(), None);
+        // Tangency (t − 1)²: none.
+        assert_eq!(Quadratic::new(1.0, -1.0, 1.0).descending_root(), None);
+    }
+
+    #[test]
+    fn roots_are_sorted_and_stable() {
+        let (r, n) = Quadratic::<f64>::new(1.0, -1e8, 1.0).roots();
+        assert_eq!(n, 2);
+        // The small root 1/(2e8) would be lost to cancellation by the textbook formula.
+        assert!((r[0] - 0.5e-8).abs() < 1e-22 && (r[1] - 2e8).abs() < 1e-6);
+        assert_eq!(Quadratic::new(0.0, 1.0, -4.0).roots(), ([2.0, 0.0], 1));
+        assert_eq!(Quadratic::new(1.0, 0.0, 1.0).roots().1, 0);
+    }
+
+    #[test]
+    fn first_descent_needs_a_positive_value_before_the_root() {
+        let q = Quadratic::new(1.0, -2.0, 3.0); // descends at 1, rises at 3
+        assert!(matches!(q.first_descent(0.0, 2.0, false), Descent::At(t) if t == 1.0));
+        assert!(matches!(
+            q.first_descent(0.0, 0.5, false),
+            Descent::Clear { armed: true }
+        ));
+        // Starting at the root, unarmed: no descent (it was never positive before).
+        assert!(matches!(
+            q.first_descent(1.0, 2.0, false),
+            Descent::Clear { armed: false }
+        ));
+        assert!(matches!(q.first_descent(1.0, 2.0, true), Descent::At(t) if t == 1.0));
+        // Rising part only: arms at the end.
+        assert!(matches!(
+            q.first_descent(2.0, 4.0, false),
+            Descent::Clear { armed: true }
+        ));
+        assert!(matches!(
+            q.first_descent(2.0, 2.5, false),
+            Descent::Clear { armed: false }
+        ));
+    }
+}
