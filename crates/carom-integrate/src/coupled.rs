@@ -190,8 +190,8 @@ fn run_staged<S: Scheme, T: Real, const D: usize, F: ForceField<T, D>>(
         };
         *carry = Carry::new(*stage);
     }
-    for i in 0..S::STAGES {
-        let time = t + h * S::stage_time::<T>(i);
+    for (i, &c) in S::STAGE_TIMES.iter().enumerate() {
+        let time = t + h * T::lit(c);
         network.write_forces(|b| (stages[b].x, stages[b].v), forces);
         for (((stage, carry), force), &m) in stages
             .iter_mut()

@@ -15,9 +15,10 @@
 //! thread timing; a parallel version would instead gather, per ball, the forces of its
 //! links in link order.)
 
-use carom_math::{InvalidValue, Problem, Real, Vector, ensure_finite_vector};
+use carom_math::{InvalidValue, Real, Vector, ensure_finite_vector};
 
 use crate::Spring;
+use crate::state::ensure_len;
 
 /// What the second end of a link is attached to.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,18 +96,7 @@ impl<T: Real, const D: usize> SpringNetwork<T, D> {
     /// # Errors
     /// `field` (out of range) if `len < self.balls_needed()`.
     pub(crate) fn ensure_balls(&self, field: &'static str, len: usize) -> Result<(), InvalidValue> {
-        if len >= self.balls_needed {
-            Ok(())
-        } else {
-            Err(InvalidValue::new(
-                field,
-                Problem::OutOfRange {
-                    value: len as f64,
-                    min: self.balls_needed as f64,
-                    max: f64::INFINITY,
-                },
-            ))
-        }
+        ensure_len(field, len, self.balls_needed, usize::MAX)
     }
 
     /// Writes the spring force on every ball into `forces` (zero for balls without
@@ -122,21 +112,9 @@ impl<T: Real, const D: usize> SpringNetwork<T, D> {
         forces: &mut [Vector<T, D>],
     ) -> Result<(), InvalidValue> {
         self.ensure_balls("positions.len", positions.len())?;
-        for (field, len) in [
-            ("velocities.len", velocities.len()),
-            ("forces.len", forces.len()),
-        ] {
-            if len != positions.len() {
-                return Err(InvalidValue::new(
-                    field,
-                    Problem::OutOfRange {
-                        value: len as f64,
-                        min: positions.len() as f64,
-                        max: positions.len() as f64,
-                    },
-                ));
-            }
-        }
+        let n = positions.len();
+        ensure_len("velocities.len", velocities.len(), n, n)?;
+        ensure_len("forces.len", forces.len(), n, n)?;
         self.write_forces(|i| (positions[i], velocities[i]), forces);
         Ok(())
     }

@@ -87,11 +87,9 @@ where
 
 /// One time-stepping scheme as a sequence of stage updates.
 pub(crate) trait Scheme {
-    /// How many evaluations of the field one step makes.
-    const STAGES: usize;
-
-    /// Where stage `stage` is evaluated, as a fraction `cᵢ` of the step.
-    fn stage_time<T: Real>(stage: usize) -> T;
+    /// Where each stage evaluates the field, as fractions `cᵢ` of the step (one entry
+    /// per evaluation).
+    const STAGE_TIMES: &'static [f64];
 
     /// Stage `stage`'s update: from the stage state `y` and its `rate`, the next stage
     /// state, or the new state after the last stage.
@@ -111,12 +109,7 @@ pub(crate) trait Scheme {
 pub(crate) struct ExplicitEuler;
 
 impl Scheme for ExplicitEuler {
-    const STAGES: usize = 1;
-
-    #[inline]
-    fn stage_time<T: Real>(_: usize) -> T {
-        T::zero()
-    }
+    const STAGE_TIMES: &'static [f64] = &[0.0];
 
     #[inline]
     fn advance<T: Real, const D: usize>(
@@ -137,12 +130,7 @@ impl Scheme for ExplicitEuler {
 pub(crate) struct SemiImplicitEuler;
 
 impl Scheme for SemiImplicitEuler {
-    const STAGES: usize = 1;
-
-    #[inline]
-    fn stage_time<T: Real>(_: usize) -> T {
-        T::zero()
-    }
+    const STAGE_TIMES: &'static [f64] = &[0.0];
 
     #[inline]
     fn advance<T: Real, const D: usize>(
@@ -174,12 +162,7 @@ impl Scheme for SemiImplicitEuler {
 pub(crate) struct VelocityVerlet;
 
 impl Scheme for VelocityVerlet {
-    const STAGES: usize = 2;
-
-    #[inline]
-    fn stage_time<T: Real>(stage: usize) -> T {
-        if stage == 0 { T::zero() } else { T::one() }
-    }
+    const STAGE_TIMES: &'static [f64] = &[0.0, 1.0];
 
     #[inline]
     fn advance<T: Real, const D: usize>(
@@ -217,16 +200,7 @@ impl Scheme for VelocityVerlet {
 pub(crate) struct Rk4;
 
 impl Scheme for Rk4 {
-    const STAGES: usize = 4;
-
-    #[inline]
-    fn stage_time<T: Real>(stage: usize) -> T {
-        match stage {
-            0 => T::zero(),
-            1 | 2 => T::lit(0.5),
-            _ => T::one(),
-        }
-    }
+    const STAGE_TIMES: &'static [f64] = &[0.0, 0.5, 0.5, 1.0];
 
     #[inline]
     fn advance<T: Real, const D: usize>(
@@ -276,8 +250,8 @@ where
 {
     let mut carry = Carry::new(y);
     let mut stage = y;
-    for i in 0..S::STAGES {
-        let time = t + h * S::stage_time::<T>(i);
+    for (i, &c) in S::STAGE_TIMES.iter().enumerate() {
+        let time = t + h * T::lit(c);
         let acceleration = field.acceleration(&stage.ball(inverse_mass, time));
         stage = S::advance(i, &mut carry, &stage, &stage.rate(acceleration), h);
     }

@@ -121,16 +121,29 @@ where
     spins: Option<&'a mut [Angular<T, D>]>,
 }
 
-fn ensure_len(field: &'static str, len: usize, expected: usize) -> Result<(), InvalidValue> {
-    if len == expected {
+/// `Ok` if a slice of length `len` has between `min` and `max` entries.
+///
+/// # Errors
+/// [`Problem::OutOfRange`] naming `field`.
+pub(crate) fn ensure_len(
+    field: &'static str,
+    len: usize,
+    min: usize,
+    max: usize,
+) -> Result<(), InvalidValue> {
+    if (min..=max).contains(&len) {
         Ok(())
     } else {
         Err(InvalidValue::new(
             field,
             Problem::OutOfRange {
                 value: len as f64,
-                min: expected as f64,
-                max: expected as f64,
+                min: min as f64,
+                max: if max == usize::MAX {
+                    f64::INFINITY
+                } else {
+                    max as f64
+                },
             },
         ))
     }
@@ -150,8 +163,18 @@ where
         velocities: &'a mut [Vector<T, D>],
         inverse_masses: &'a [T],
     ) -> Result<Self, InvalidValue> {
-        ensure_len("velocities.len", velocities.len(), positions.len())?;
-        ensure_len("inverse_masses.len", inverse_masses.len(), positions.len())?;
+        ensure_len(
+            "velocities.len",
+            velocities.len(),
+            positions.len(),
+            positions.len(),
+        )?;
+        ensure_len(
+            "inverse_masses.len",
+            inverse_masses.len(),
+            positions.len(),
+            positions.len(),
+        )?;
         Ok(Self {
             positions,
             velocities,
@@ -166,7 +189,8 @@ where
     /// # Errors
     /// `spins.len` if its length differs from the number of balls.
     pub fn with_spins(self, spins: &'a mut [Angular<T, D>]) -> Result<Self, InvalidValue> {
-        ensure_len("spins.len", spins.len(), self.positions.len())?;
+        let n = self.positions.len();
+        ensure_len("spins.len", spins.len(), n, n)?;
         Ok(Self {
             spins: Some(spins),
             ..self
