@@ -155,7 +155,7 @@ where
     /// sign) in this field. A ball of infinite mass (`inverse_mass == 0`) keeps its
     /// velocity and spin.
     ///
-    /// The spin decays as `ω(t) = e^{−λ t} ω₀` (there is no torque other than damping in
+    /// The spin decays as `ω(t) = e^{−λ t}ω₀` (there is no torque other than damping in
     /// this family).
     #[inline]
     pub fn advance(
@@ -166,15 +166,42 @@ where
         inverse_mass: T,
         t: T,
     ) -> (PointState<T, D>, Angular<T, D>) {
+        self.advance_with_spin_decay(
+            self.spin_decay(t),
+            position,
+            velocity,
+            spin,
+            inverse_mass,
+            t,
+        )
+    }
+
+    /// The spin factor `e^{−λ t}` of balls of finite mass, the same for all of them.
+    #[inline]
+    pub(crate) fn spin_decay(&self, t: T) -> T {
+        if self.spin_damping == T::zero() {
+            T::one()
+        } else {
+            (-self.spin_damping * t).exp()
+        }
+    }
+
+    /// [`ClosedForm::advance`] with the spin factor `e^{−λ t}` computed by the caller
+    /// (once per step for all balls).
+    #[inline]
+    pub(crate) fn advance_with_spin_decay(
+        &self,
+        spin_decay: T,
+        position: &Vector<T, D>,
+        velocity: &Vector<T, D>,
+        spin: &Angular<T, D>,
+        inverse_mass: T,
+        t: T,
+    ) -> (PointState<T, D>, Angular<T, D>) {
         if inverse_mass > T::zero() {
             let k = self.linear_drag * inverse_mass;
             let moved = linear_drag(position, velocity, &self.gravity, k, t);
-            let spin = if self.spin_damping == T::zero() {
-                *spin
-            } else {
-                *spin * (-self.spin_damping * t).exp()
-            };
-            (moved, spin)
+            (moved, *spin * spin_decay)
         } else {
             let moved = PointState {
                 position: position + velocity * t,

@@ -145,16 +145,18 @@ where
             Plan::VelocityVerlet => run!(VelocityVerlet),
             Plan::Rk4 => run!(Rk4),
             Plan::Exact(cf) => {
-                update_each(arrays, |y, m| advance_exact(cf, &y, m, h));
+                let spin_decay = cf.spin_decay(h);
+                update_each(arrays, |y, m| advance_exact(cf, spin_decay, &y, m, h));
             }
         }
     }
 }
 
-/// One exact step of one ball.
+/// One exact step of one ball, given the step's spin factor `e^{−λ h}`.
 #[inline]
 pub(crate) fn advance_exact<T: Real, const D: usize>(
     closed_form: &ClosedForm<T, D>,
+    spin_decay: T,
     y: &Phase<T, D>,
     inverse_mass: T,
     h: T,
@@ -162,7 +164,8 @@ pub(crate) fn advance_exact<T: Real, const D: usize>(
 where
     Const<D>: Space<T, D>,
 {
-    let (moved, w) = closed_form.advance(&y.x, &y.v, &y.w, inverse_mass, h);
+    let (moved, w) =
+        closed_form.advance_with_spin_decay(spin_decay, &y.x, &y.v, &y.w, inverse_mass, h);
     Phase {
         x: moved.position,
         v: moved.velocity,
