@@ -88,6 +88,12 @@ where
         let speed = ball.velocity.norm();
         Acceleration::linear(ball.velocity * -(self.coefficient * ball.inverse_mass * speed))
     }
+
+    /// Free flight when the coefficient is zero (so a fixed composition with unused
+    /// parts set to zero keeps the exact integrator); otherwise none.
+    fn closed_form(&self) -> Option<ClosedForm<T, D>> {
+        (self.coefficient == T::zero()).then(ClosedForm::free)
+    }
 }
 
 #[cfg(test)]
@@ -123,5 +129,16 @@ mod tests {
         assert_eq!(LinearDrag::new(-0.1).unwrap_err().field, "coefficient");
         assert!(QuadraticDrag::new(f32::INFINITY).is_err());
         assert!(LinearDrag::new(0.0_f32).is_ok());
+    }
+
+    #[test]
+    fn quadratic_drag_has_a_closed_form_only_when_it_is_zero() {
+        let zero = QuadraticDrag::new(0.0).unwrap();
+        assert_eq!(
+            ForceField::<f64, 2>::closed_form(&zero),
+            Some(ClosedForm::free())
+        );
+        let some = QuadraticDrag::new(1e-4).unwrap();
+        assert_eq!(ForceField::<f64, 2>::closed_form(&some), None);
     }
 }

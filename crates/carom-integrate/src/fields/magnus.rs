@@ -51,6 +51,11 @@ where
         let w_cross_v = <Const<D> as Space<T, D>>::angular_cross(&ball.spin, &ball.velocity);
         Acceleration::linear(w_cross_v * (self.coefficient * ball.inverse_mass))
     }
+
+    /// Free flight when the coefficient is zero; otherwise none.
+    fn closed_form(&self) -> Option<ClosedForm<T, D>> {
+        (self.coefficient == T::zero()).then(ClosedForm::free)
+    }
 }
 
 /// Spin damping `dω/dt = −λ ω` for balls of finite mass: the spin decays as `e^{−λ t}`.
@@ -154,5 +159,14 @@ mod tests {
         assert_eq!(damping.acceleration(&ball), Acceleration::zero());
         assert_eq!(SpinDamping::new(-1.0_f32).unwrap_err().field, "rate");
         assert_eq!(Magnus::new(f64::NAN).unwrap_err().field, "coefficient");
+        let off = Magnus::new(0.0).unwrap();
+        assert_eq!(
+            ForceField::<f64, 3>::closed_form(&off),
+            Some(ClosedForm::free())
+        );
+        assert_eq!(
+            ForceField::<f64, 3>::closed_form(&Magnus::new(1e-6).unwrap()),
+            None
+        );
     }
 }

@@ -19,7 +19,7 @@
 use carom_math::{InvalidValue, Real, Space, Vector, ensure_finite_vector, ensure_non_negative};
 use nalgebra::Const;
 
-use crate::{Acceleration, BallState, ForceField};
+use crate::{Acceleration, BallState, ClosedForm, ForceField};
 
 /// The parameters of a damped Hooke spring: stiffness `k`, damping `c`, rest length `L`.
 ///
@@ -136,6 +136,12 @@ where
             .force(&(ball.position - self.anchor), &ball.velocity);
         Acceleration::linear(force * ball.inverse_mass)
     }
+
+    /// Free flight when the spring has neither stiffness nor damping; otherwise none.
+    fn closed_form(&self) -> Option<ClosedForm<T, D>> {
+        (self.spring.stiffness == T::zero() && self.spring.damping == T::zero())
+            .then(ClosedForm::free)
+    }
 }
 
 #[cfg(test)]
@@ -200,5 +206,10 @@ mod tests {
                 .field,
             "anchor[1]"
         );
+        let slack =
+            AnchorSpring::new(Vector2::new(1.0, 2.0), Spring::new(0.0, 0.0, 3.0).unwrap()).unwrap();
+        assert_eq!(slack.closed_form(), Some(ClosedForm::free()));
+        let taut = AnchorSpring::new(Vector2::new(1.0, 2.0), s).unwrap();
+        assert_eq!(taut.closed_form(), None);
     }
 }
