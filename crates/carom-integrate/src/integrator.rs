@@ -1,0 +1,179 @@
+//! The integration schemes by name: [`Integrator`], its command-line names and what
+//! theory says about each (order, evaluations per step, stability on the oscillator).
+//!
+//! ## Stability on the undamped oscillator `ẍ = −ω² x`
+//!
+//! One step of size `h` multiplies `(x, v)` by a matrix `M(ωh)`; the scheme is stable
+//! when the powers of `M` stay bounded. With `E = (v² + ω² x²)/2`:
+//!
+//! * **Explicit Euler** `x' = x + h v`, `v' = v − h ω² x`:
+//!   `E' = ((v − hω²x)² + ω²(x + hv)²)/2 = (1 + ω²h²) E` — the cross terms cancel, so the
+//!   energy grows by exactly `1 + ω²h²` every step, at any `h`. Never stable.
+//! * **Semi-implicit Euler** `v' = v − hω²x`, `x' = x + h v'` and **velocity Verlet**
+//!   `x' = x + hv − h²ω²x/2`, `v' = v − hω²(x + x')/2`: `det M = 1` (both are
+//!   symplectic) and `tr M = 2 − ω²h²`, so the eigenvalues `λ` solve
+//!   `λ² − (2 − ω²h²) λ + 1 = 0`. For `ωh < 2` they are a conjugate pair on the unit
+//!   circle (bounded; a modified energy is conserved); for `ωh > 2` they are real with
+//!   product 1, and the larger grows like `|λ|ⁿ`. Stable for `ωh < 2`.
+//! * **RK4** multiplies by `R(iωh)` with `R(z) = 1 + z + z²/2 + z³/6 + z⁴/24`, and
+//!   `|R(iy)|² = 1 − y⁶/72 + y⁸/576`, which is `≤ 1` exactly when `y ≤ 2√2`. Stable for
+//!   `ωh ≤ 2√2` (with a slight energy loss below the limit).
+//! * **Exact** has no truncation error and no step limit.
+
+use core::fmt;
+use core::str::FromStr;
+
+/// An integration scheme. The [`FromStr`] and [`Display`](fmt::Display) forms are the
+/// names `carom run --integrator` takes: `explicit-euler`, `semi-implicit-euler`,
+/// `verlet`, `rk4`, `exact`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Integrator {
+    /// `x += h v; v += h a(x, v)`: position with the old velocity. First order; gains
+    /// energy on every undamped oscillator. A baseline, not a choice.
+    ExplicitEuler,
+    /// `v += h a(x, v); x += h v`: position with the new velocity (the scheme of the
+    /// ping-pong paper; symplectic Euler). First order, one evaluation per step, stable
+    /// for `ωh < 2`, energy bounded over long runs.
+    SemiImplicitEuler,
+    /// Velocity Verlet: `x += h v + h² a/2`, then `v += h (a + a')/2` with `a'` at the new
+    /// position. Second order, two evaluations per step (the stepper does not cache the
+    /// last one: collisions change velocities between steps), stable for `ωh < 2`.
+    /// Velocity-dependent forces see the predicted velocity `v + h a` at the new
+    /// position, which keeps second order (the scheme is then Heun's method in
+    /// velocity); it is symplectic only for position-dependent forces.
+    VelocityVerlet,
+    /// The classical fourth-order Runge–Kutta method: four evaluations per step, stable
+    /// for `ωh ≤ 2√2`, not symplectic (it loses a little energy every step).
+    Rk4,
+    /// The closed form of gravity plus linear drag plus spin damping ([`exact`](crate::exact)):
+    /// exact to rounding at any step, for fields that have one.
+    Exact,
+}
+
+impl Integrator {
+    /// Every integrator, in the order of the documentation.
+    pub const ALL: [Integrator; 5] = [
+        Integrator::ExplicitEuler,
+        Integrator::SemiImplicitEuler,
+        Integrator::VelocityVerlet,
+        Integrator::Rk4,
+        Integrator::Exact,
+    ];
+
+    /// The command-line name (`explicit-euler`, `semi-implicit-euler`, `verlet`, `rk4`,
+    /// `exact`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Integrator::ExplicitEuler => "explicit-euler",
+            Integrator::SemiImplicitEuler => "semi-implicit-euler",
+            Integrator::VelocityVerlet => "verlet",
+            Integrator::Rk4 => "rk4",
+            Integrator::Exact => "exact",
+        }
+    }
+
+    /// The order of the global error (`error = O(hᵖ)`); `None` for the exact integrator,
+    /// which has no truncation error.
+    pub const fn order(self) -> Option<u32> {
+        match self {
+            Integrator::ExplicitEuler | Integrator::SemiImplicitEuler => Some(1),
+            Integrator::VelocityVerlet => Some(2),
+            Integrator::Rk4 => Some(4),
+            Integrator::Exact => None,
+        }
+    }
+
+    /// Force-field evaluations per ball per step.
+    pub const fn evaluations_per_step(self) -> usize {
+        match self {
+            Integrator::ExplicitEuler | Integrator::SemiImplicitEuler => 1,
+            Integrator::VelocityVerlet => 2,
+            Integrator::Rk4 => 4,
+            Integrator::Exact => 0,
+        }
+    }
+
+    /// The largest `ωh` at which the undamped oscillator `ẍ = −ω² x` stays bounded (see
+    /// the [module documentation](self)): `0` for explicit Euler (never), `2` for
+    /// semi-implicit Euler and Verlet, `2√2` for RK4, infinity for the exact integrator.
+    pub fn oscillator_stability_limit(self) -> f64 {
+        match self {
+            Integrator::ExplicitEuler => 0.0,
+            Integrator::SemiImplicitEuler | Integrator::VelocityVerlet => 2.0,
+            Integrator::Rk4 => 2.0 * core::f64::consts::SQRT_2,
+            Integrator::Exact => f64::INFINITY,
+        }
+    }
+}
+
+impl fmt::Display for Integrator {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A name that is not one of the integrators' command-line names.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "unknown integrator `{0}`: expected one of explicit-euler, semi-implicit-euler, verlet, rk4, exact"
+)]
+pub struct UnknownIntegrator(pub String);
+
+impl FromStr for Integrator {
+    type Err = UnknownIntegrator;
+
+    /// Parses a command-line name exactly (case-sensitive, no aliases).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Integrator::ALL
+            .into_iter()
+            .find(|i| i.name() == s)
+            .ok_or_else(|| UnknownIntegrator(s.to_owned()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_are_the_cli_names() {
+        let names: Vec<String> = Integrator::ALL.iter().map(ToString::to_string).collect();
+        assert_eq!(
+            names,
+            [
+                "explicit-euler",
+                "semi-implicit-euler",
+                "verlet",
+                "rk4",
+                "exact"
+            ]
+        );
+        for i in Integrator::ALL {
+            assert_eq!(i.to_string().parse::<Integrator>(), Ok(i));
+        }
+    }
+
+    #[test]
+    fn unknown_names_are_rejected_with_the_list_of_valid_ones() {
+        let e = "RK4".parse::<Integrator>().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "unknown integrator `RK4`: expected one of explicit-euler, semi-implicit-euler, verlet, rk4, exact"
+        );
+        assert!("euler".parse::<Integrator>().is_err());
+        assert!("".parse::<Integrator>().is_err());
+    }
+
+    #[test]
+    fn rk4_limit_is_where_its_amplification_factor_reaches_one() {
+        // |R(iy)|² = 1 − y⁶/72 + y⁸/576 from the complex polynomial itself.
+        let r2 = |y: f64| {
+            let re = 1.0 - y * y / 2.0 + y.powi(4) / 24.0;
+            let im = y - y.powi(3) / 6.0;
+            re * re + im * im
+        };
+        let y = Integrator::Rk4.oscillator_stability_limit();
+        assert!((r2(y) - 1.0).abs() < 1e-14);
+        assert!(r2(0.999 * y) < 1.0 && r2(1.001 * y) > 1.0);
+    }
+}
