@@ -166,12 +166,12 @@ pub fn plan<T: Real, const D: usize>(
             (None, false) => (EngineKind::Event, "the scene can be simulated exactly"),
         },
     };
-    if let Some(dt) = options.dt {
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(PlanError(format!(
-                "--dt: must be a finite step > 0, got {dt}"
-            )));
-        }
+    if let Some(dt) = options.dt
+        && !(dt.is_finite() && dt > 0.0)
+    {
+        return Err(PlanError(format!(
+            "--dt: must be a finite step > 0, got {dt}"
+        )));
     }
     if engine == EngineKind::Event && matches!(options.broad, BroadChoice::Sap | BroadChoice::Kd) {
         return Err(PlanError(format!(
