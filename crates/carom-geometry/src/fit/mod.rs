@@ -1,0 +1,1 @@
+//! Bounding volumes fitted to point sets.
