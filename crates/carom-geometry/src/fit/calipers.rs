@@ -140,7 +140,7 @@ fn calipers_direction<T: Real>(hull: &[Vector2<T>]) -> Vector2<T> {
 ///
 /// // A diamond: the best rectangle is the square along its edges, of area 2 (not 4).
 /// let pts = [
-///     Vector2::new(1.0, 0.0), Vector2::new(0.0, 1.0),
+///     Vector2::new(1.0_f64, 0.0), Vector2::new(0.0, 1.0),
 ///     Vector2::new(-1.0, 0.0), Vector2::new(0.0, -1.0),
 /// ];
 /// let r = min_area_rect(&pts)?;

@@ -19,6 +19,7 @@
 //! Fitting allocates (a copy of the points for Welzl, the hull); the queries do not.
 //!
 //! [`PointQuery::contains_point`]: crate::query::PointQuery::contains_point
+//! [`BoundingSphere::contains_point`]: crate::BoundingSphere::contains_point
 
 mod calipers;
 mod pca;

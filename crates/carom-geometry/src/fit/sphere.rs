@@ -246,7 +246,7 @@ const SHUFFLE_SEED: u64 = 0x6361_726F_6D00_0001;
 /// use nalgebra::Vector2;
 ///
 /// // A right triangle: the minimal circle has the hypotenuse as diameter.
-/// let pts = [Vector2::new(0.0, 0.0), Vector2::new(4.0, 0.0), Vector2::new(0.0, 3.0)];
+/// let pts = [Vector2::new(0.0_f64, 0.0), Vector2::new(4.0, 0.0), Vector2::new(0.0, 3.0)];
 /// let s = minimal_sphere(&pts)?;
 /// assert!((s.radius() - 2.5).abs() < 1e-12);
 /// # Ok::<(), carom_geometry::InvalidValue>(())

@@ -42,7 +42,7 @@ pub struct Contact<T: Real, const D: usize> {
 /// use carom_geometry::{d2, query::contact};
 /// use nalgebra::Vector2;
 ///
-/// let ball = d2::Ball::new(Vector2::new(0.0, 0.9), 1.0)?;
+/// let ball: d2::Ball = d2::Ball::new(Vector2::new(0.0, 0.9), 1.0)?;
 /// let floor = d2::HalfSpace::new(Vector2::new(0.0, 1.0), Vector2::new(0.0, 0.0))?;
 /// let c = contact(&ball, &floor).expect("the ball sinks 0.1 into the floor");
 /// assert_eq!(c.normal, Vector2::new(0.0, 1.0));

@@ -1,18 +1,5 @@
 //! Distances between shapes, and signed distances that go negative in penetration.
-//!
-//! The signed distance of two shapes is their distance when apart and minus their
-//! penetration depth (the length of the shortest translation that separates them) when
-//! they overlap. Every pair here has it exactly (up to rounding):
-//!
-//! | pair | signed distance |
-//! |---|---|
-//! | ball–shape | the signed distance of the centre to the shape, minus the radius |
-//! | AABB–AABB | apart: the length of the per-axis gaps; overlapping: the largest (least negative) per-axis gap |
-//! | box–half-space | the signed distance of the box's deepest point |
-//! | box–box with an OBB | apart: the closest features ([`box_distance`](super::box_distance)); overlapping: the SAT depth ([`separation`](super::separation)) |
-//!
-//! The box–box distance with an OBB costs far more than the others (hundreds of flops in
-//! 3D); everything else is a handful of operations.
+//! (See [`Distance`] for the methods.)
 
 use carom_math::{Real, Space};
 use nalgebra::Const;
@@ -23,6 +10,23 @@ use crate::query::sat::RelativeBoxes;
 use crate::{Aabb, Ball, BoundingVolume, HalfSpace, Obb};
 
 /// The distance between two shapes, and its signed form.
+///
+/// The signed distance of two shapes is their distance when apart and minus their
+/// penetration depth (the length of the shortest translation that separates them) when
+/// they overlap. Every pair has it exactly, up to rounding:
+///
+/// | pair | signed distance |
+/// |---|---|
+/// | ball–shape | the signed distance of the centre to the shape, minus the radius |
+/// | AABB–AABB | apart: the length of the per-axis gaps; overlapping: the largest (least negative) per-axis gap |
+/// | box–half-space | the signed distance of the box's deepest point along `−n` |
+/// | box–box with an OBB | apart: the smallest of the corner–box and (3D) edge–edge distances; overlapping: the SAT depth ([`separation`](super::separation)) |
+///
+/// The box–box distance with an OBB is the expensive one: when the boxes are apart it
+/// tries every closest-feature candidate (8 corner–box tests in 2D; 16 corner–box and
+/// 144 edge–edge tests in 3D), a fixed cost of a few microseconds at most and no
+/// allocation. Everything else is a handful of operations. Two half-spaces are not
+/// covered.
 pub trait Distance<T: Real, Rhs: ?Sized> {
     /// The distance when apart, minus the penetration depth when overlapping.
     fn signed_distance(&self, other: &Rhs) -> T;

@@ -1,16 +1,4 @@
-//! Overlap tests: do two shapes share a point? Touching counts.
-//!
-//! | pair | method |
-//! |---|---|
-//! | ball–ball | `|c₁ − c₂|² <= (r₁ + r₂)²` |
-//! | ball–box | the closest-point clamp: `|c − clamp(c)|² <= r²` (in the box frame for an OBB) |
-//! | ball–half-space | `n · c − offset <= r` |
-//! | box–box | AABB–AABB by intervals; with an OBB, the separating-axis test ([`sat`](super::sat)) |
-//! | box–half-space | the projected radius: the box's support point in `−n` is inside |
-//!
-//! Every test is symmetric (`a.overlaps(&b) == b.overlaps(&a)`), square-root free and
-//! allocation-free. Two half-spaces are not covered: their overlap is almost always
-//! `true` and no simulation asks for it.
+//! Overlap tests: do two shapes share a point? (See [`Overlap`] for the methods.)
 
 use carom_math::{Real, Space};
 use nalgebra::Const;
@@ -19,6 +7,19 @@ use crate::query::sat::RelativeBoxes;
 use crate::{Aabb, Ball, BoundingVolume, HalfSpace, Obb};
 
 /// Whether two shapes overlap (share at least one point; touching counts).
+///
+/// | pair | method |
+/// |---|---|
+/// | ball–ball | `|c₁ − c₂|² <= (r₁ + r₂)²` |
+/// | ball–box | the closest-point clamp: `|c − clamp(c)|² <= r²` (in the box frame for an OBB) |
+/// | ball–half-space | `n · c − offset <= r` |
+/// | AABB–AABB | the intervals overlap on every axis |
+/// | box–box with an OBB | the separating-axis test over 4 axes (2D) or 15 (3D), see [`separation`](super::separation) for parallel edges |
+/// | box–half-space | the box's deepest point along `−n` is inside (the projected radius) |
+///
+/// Every test is symmetric (`a.overlaps(&b) == b.overlaps(&a)`), square-root free and
+/// allocation-free. Two half-spaces are not covered: their overlap is almost always
+/// `true` and no simulation asks for it.
 pub trait Overlap<Rhs: ?Sized> {
     /// `true` if `self` and `other` overlap or touch.
     fn overlaps(&self, other: &Rhs) -> bool;

@@ -1,37 +1,6 @@
 //! The separating-axis test (SAT) for two boxes: an overlap test and the signed gap along
-//! the best separating axis.
-//!
-//! Two convex polytopes are disjoint exactly when their projections on some axis are
-//! disjoint, and it suffices to try the face normals of both and, in 3D, the cross
-//! products of an edge direction of each: `D + D` face axes plus 9 edge axes in 3D
-//! (4 axes in 2D, 15 in 3D). On an axis `L` the boxes project to intervals of radii
-//! `r_A = Σ hA_k |a_k · L|`, `r_B = Σ hB_k |b_k · L|` around the projected centres, and
-//! they are separated along `L` when `|t · L| > r_A + r_B` (`t` = centre of B − centre of A).
-//!
-//! Everything is computed in A's frame (Gottschalk's OBBTree form, as in Ericson,
-//! *Real-Time Collision Detection* §4.4.1): A's axes are the unit vectors, B's axes are the
-//! columns of `R = R_Aᵀ R_B`, and `t` is expressed in A's frame. The 3D edge axes come
-//! from [`Space::edge_axes`] (none in 2D).
-//!
-//! # Parallel edges
-//!
-//! When an edge of A is parallel to an edge of B, their cross product is zero and so are
-//! both sides of the test, and rounding noise in `R` (a few ulp) can make `|t · L|` exceed
-//! `r_A + r_B` and report a false separation. Two remedies, used for two jobs:
-//!
-//! * **The overlap test adds a slack `ε = 16 ulp` to every `|R_ij|`** (Ericson's fix):
-//!   each projected radius grows by `ε Σ h`, a length relative to the box sizes, which
-//!   dominates the noise of a near-zero axis (whose `|t · L|` is at most a few ulp times
-//!   `|t|`, and `|t| <= Σ hA + Σ hB` for boxes that could touch). A zero axis can then never
-//!   separate, and no axis is normalised, so the test stays branch-light. The price is that
-//!   boxes closer than `ε Σ h` may be reported as overlapping: the test errs towards
-//!   contact, never towards a missed one.
-//! * **The signed separation skips edge axes shorter than `√ε`** (relative to unit axes):
-//!   it must normalise each axis to compare gaps, and a near-zero axis amplifies rounding
-//!   by `1/|L|`. Skipping loses little: as the edges become parallel the gap along their
-//!   cross product tends to a gap along a face axis (the problem reduces to 2D in the plane
-//!   across the edges, where face normals suffice), so the skipped axis changes the answer
-//!   by `O(|L| · size)`. With the cut at `√ε` both errors are `O(√ε · size)`.
+//! the best separating axis. The method and its treatment of parallel edges are
+//! documented on [`separation`].
 
 use carom_math::{Real, Rotation, Space, Vector};
 use nalgebra::{Const, SMatrix};
@@ -195,8 +164,40 @@ impl<T: Real, const D: usize> RelativeBoxes<T, D> {
 /// For axis-aligned boxes, convert with [`Obb::from_aabb`].
 ///
 /// Ties between axes go to the first in the order: A's faces, B's faces, edge crosses
-/// (lowest index first); a gap of zero along an axis through both centres points along
-/// `+axis`. See the [module notes](self) for parallel edges.
+/// (lowest index first); an axis along which the centres do not differ points along
+/// `+axis`.
+///
+/// Two convex polytopes are disjoint exactly when their projections on some axis are
+/// disjoint, and it suffices to try the face normals of both and, in 3D, the cross
+/// products of an edge direction of each: `D + D` face axes plus 9 edge axes in 3D
+/// (4 axes in 2D, 15 in 3D). On an axis `L` the boxes project to intervals of radii
+/// `r_A = Σ hA_k |a_k · L|`, `r_B = Σ hB_k |b_k · L|` around the projected centres, and
+/// they are separated along `L` when `|t · L| > r_A + r_B` (`t` = centre of B − centre of A).
+///
+/// Everything is computed in A's frame (Gottschalk's OBBTree form, as in Ericson,
+/// *Real-Time Collision Detection* §4.4.1): A's axes are the unit vectors, B's axes are the
+/// columns of `R = R_Aᵀ R_B`, and `t` is expressed in A's frame. The 3D edge axes come
+/// from [`Space::edge_axes`] (none in 2D).
+///
+/// # Parallel edges
+///
+/// When an edge of A is parallel to an edge of B, their cross product is zero and so are
+/// both sides of the test, and rounding noise in `R` (a few ulp) can make `|t · L|` exceed
+/// `r_A + r_B` and report a false separation. Two remedies, used for two jobs:
+///
+/// * **The box–box [`Overlap`](super::Overlap) test adds a slack `ε = 16 ulp` to every
+///   `|R_ij|`** (Ericson's fix): each projected radius grows by `ε Σ h`, a length
+///   relative to the box sizes, which dominates the noise of a near-zero axis (whose `|t · L|` is at most a few ulp times
+///   `|t|`, and `|t| <= Σ hA + Σ hB` for boxes that could touch). A zero axis can then never
+///   separate, and no axis is normalised, so the test stays branch-light. The price is that
+///   boxes closer than `ε Σ h` may be reported as overlapping: the test errs towards
+///   contact, never towards a missed one.
+/// * **The signed separation skips edge axes shorter than `√ε`** (relative to unit axes):
+///   it must normalise each axis to compare gaps, and a near-zero axis amplifies rounding
+///   by `1/|L|`. Skipping loses little: as the edges become parallel the gap along their
+///   cross product tends to a gap along a face axis (the problem reduces to 2D in the plane
+///   across the edges, where face normals suffice), so the skipped axis changes the answer
+///   by `O(|L| · size)`. With the cut at `√ε` both errors are `O(√ε · size)`.
 ///
 /// ```
 /// use carom_geometry::{d2, query::separation};
