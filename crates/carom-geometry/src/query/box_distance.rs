@@ -8,10 +8,12 @@
 //! * in 3D, every edge of A against every edge of B (segment–segment, Ericson §5.1.9).
 //!
 //! In 2D two disjoint convex polygons always have a closest pair with a vertex in it, so
-//! the edge pairs add nothing and are skipped. The cost is fixed and allocation-free:
-//! 8 point–box tests in 2D; 16 point–box and 144 segment–segment tests in 3D. Every
-//! candidate is a true pair of points of the two boxes, so rounding can only make a
-//! candidate slightly long, never report less than the distance by more than rounding.
+//! the edge pairs add nothing and are skipped. At most that is 8 point–box tests in 2D,
+//! 16 point–box and 144 segment–segment tests in 3D; the separating axis from the SAT
+//! prunes every feature pair that cannot beat the best distance found so far, which
+//! leaves the few features facing each other. No allocation. Every candidate is a true
+//! pair of points of the two boxes, so rounding can only make a candidate slightly long,
+//! never report less than the distance by more than rounding.
 
 use carom_math::{Real, Vector};
 
@@ -74,30 +76,81 @@ fn segment_segment_distance_squared<T: Real, const D: usize>(
 }
 
 impl<T: Real, const D: usize> RelativeBoxes<T, D> {
-    /// The distance between the boxes, for boxes known to be disjoint (for overlapping
-    /// boxes the result is not meaningful; callers run the SAT first).
-    pub(crate) fn disjoint_distance(&self) -> T {
+    /// The distance between the boxes, for boxes separated along `axis` (unit, in A's
+    /// frame, from B towards A, as [`RelativeBoxes::separation`] returns it with a
+    /// positive gap). For overlapping boxes the result is not meaningful.
+    ///
+    /// The separating axis prunes the search. Along `u = −axis` every point of A lies at
+    /// or below `max_A = Σ hA_i |u_i|` and every point of B at or above
+    /// `min_B = t·u − Σ hB_j |(Rᵀu)_j|`, so a feature pair whose projections are `g` apart
+    /// on `u` is at least `g` apart in space. Features are tried after the two support
+    /// corners (A's highest and B's lowest on `u`, which give a first bound), and any
+    /// whose projected gap already exceeds the best distance found is skipped: only the
+    /// features facing each other are measured.
+    pub(crate) fn disjoint_distance(&self, axis: &Vector<T, D>) -> T {
         let corners = 1usize << D;
-        let b_world = |local: Vector<T, D>| self.t + self.r * local;
-        let mut best = T::INFINITY;
+        let u = -axis;
+        let u_in_b = self.r.tr_mul(&u);
+        let t_u = self.t.dot(&u);
+        let a_top = self.ha.dot(&u.abs());
+        let b_bottom = t_u - self.hb.dot(&u_in_b.abs());
+        // Heights on u of every corner of A and of B (at most 8 each).
+        let mut a_height = [T::zero(); 8];
+        let mut b_height = [T::zero(); 8];
         for k in 0..corners {
-            // A's corner in B's frame: Rᵀ (p − t).
+            a_height[k] = corner(&self.ha, k).dot(&u);
+            b_height[k] = t_u + corner(&self.hb, k).dot(&u_in_b);
+        }
+        let b_world = |local: Vector<T, D>| self.t + self.r * local;
+        let a_corner_to_b = |k: usize| {
             let a_in_b = self.r.tr_mul(&(corner(&self.ha, k) - self.t));
-            best = best.min(point_box_distance_squared(&a_in_b, &self.hb));
-            best = best.min(point_box_distance_squared(
-                &b_world(corner(&self.hb, k)),
-                &self.ha,
-            ));
+            point_box_distance_squared(&a_in_b, &self.hb)
+        };
+        let b_corner_to_a =
+            |m: usize| point_box_distance_squared(&b_world(corner(&self.hb, m)), &self.ha);
+        let highest = (0..corners).fold(0, |best, k| {
+            if a_height[k] > a_height[best] {
+                k
+            } else {
+                best
+            }
+        });
+        let lowest = (0..corners).fold(0, |best, m| {
+            if b_height[m] < b_height[best] {
+                m
+            } else {
+                best
+            }
+        });
+        let mut best = a_corner_to_b(highest).min(b_corner_to_a(lowest));
+        // A squared bound against the squared best: `g > 0` for every feature here.
+        let beaten = |gap: T, best: T| gap > T::zero() && gap * gap >= best;
+        for k in 0..corners {
+            if !beaten(b_bottom - a_height[k], best) {
+                best = best.min(a_corner_to_b(k));
+            }
+            if !beaten(b_height[k] - a_top, best) {
+                best = best.min(b_corner_to_a(k));
+            }
         }
         if D >= 3 {
             // Edges: corner k to corner k + 2^i for each k with bit i clear.
             for i in 0..D {
                 for k in (0..corners).filter(|k| k >> i & 1 == 0) {
-                    let (p1, q1) = (corner(&self.ha, k), corner(&self.ha, k | 1 << i));
+                    let k2 = k | 1 << i;
+                    let a_high = a_height[k].max(a_height[k2]);
+                    if beaten(b_bottom - a_high, best) {
+                        continue;
+                    }
+                    let (p1, q1) = (corner(&self.ha, k), corner(&self.ha, k2));
                     for j in 0..D {
                         for m in (0..corners).filter(|m| m >> j & 1 == 0) {
+                            let m2 = m | 1 << j;
+                            if beaten(b_height[m].min(b_height[m2]) - a_high, best) {
+                                continue;
+                            }
                             let p2 = b_world(corner(&self.hb, m));
-                            let q2 = b_world(corner(&self.hb, m | 1 << j));
+                            let q2 = b_world(corner(&self.hb, m2));
                             best = best.min(segment_segment_distance_squared(&p1, &q1, &p2, &q2));
                         }
                     }
@@ -155,6 +208,57 @@ mod tests {
         );
     }
 
+    /// Every corner–box and edge–edge pair, without pruning.
+    fn brute_force(rel: &RelativeBoxes<f64, 3>) -> f64 {
+        let b_world = |local: Vector3<f64>| rel.t + rel.r * local;
+        let mut best = f64::INFINITY;
+        for k in 0..8 {
+            let a_in_b = rel.r.tr_mul(&(corner(&rel.ha, k) - rel.t));
+            best = best.min(point_box_distance_squared(&a_in_b, &rel.hb));
+            best = best.min(point_box_distance_squared(
+                &b_world(corner(&rel.hb, k)),
+                &rel.ha,
+            ));
+        }
+        for i in 0..3 {
+            for k in (0..8).filter(|k| k >> i & 1 == 0) {
+                for j in 0..3 {
+                    for m in (0..8).filter(|m| m >> j & 1 == 0) {
+                        best = best.min(segment_segment_distance_squared(
+                            &corner(&rel.ha, k),
+                            &corner(&rel.ha, k | 1 << i),
+                            &b_world(corner(&rel.hb, m)),
+                            &b_world(corner(&rel.hb, m | 1 << j)),
+                        ));
+                    }
+                }
+            }
+        }
+        best.sqrt()
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn pruning_by_the_separating_axis_loses_no_feature(
+            c in proptest::array::uniform3(-3.0..3.0f64),
+            ha in proptest::array::uniform3(0.0..1.5f64),
+            hb in proptest::array::uniform3(0.0..1.5f64),
+            wa in proptest::array::uniform3(-3.0..3.0f64),
+            wb in proptest::array::uniform3(-3.0..3.0f64),
+        ) {
+            let a = Obb::from_axis_angle(Vector3::zeros(), ha.into(), wa.into()).unwrap();
+            let b = Obb::from_axis_angle(c.into(), hb.into(), wb.into()).unwrap();
+            let rel = RelativeBoxes::of_obbs(&a, &b);
+            let (axis, gap) = rel.separation();
+            if gap > 0.0 {
+                let pruned = rel.disjoint_distance(&axis);
+                let all = brute_force(&rel);
+                proptest::prop_assert!((pruned - all).abs() <= 1e-12 * (1.0 + all), "{pruned} vs {all}");
+                proptest::prop_assert!(pruned >= gap * (1.0 - 1e-12), "SAT gaps are lower bounds");
+            }
+        }
+    }
+
     #[test]
     fn crossed_edges_of_turned_cubes() {
         // The edge–edge case in 3D: no corner is closest.
@@ -171,8 +275,9 @@ mod tests {
             Vector3::new(0.0, q, 0.0),
         )
         .unwrap();
+        let rel = RelativeBoxes::of_obbs(&a, &b);
         assert_relative_eq!(
-            RelativeBoxes::of_obbs(&a, &b).disjoint_distance(),
+            rel.disjoint_distance(&rel.separation().0),
             0.5,
             epsilon = 1e-12
         );
@@ -187,8 +292,9 @@ mod tests {
             core::f64::consts::FRAC_PI_4,
         )
         .unwrap();
+        let rel = RelativeBoxes::of_obbs(&a, &b);
         assert_relative_eq!(
-            RelativeBoxes::of_obbs(&a, &b).disjoint_distance(),
+            rel.disjoint_distance(&rel.separation().0),
             2.0,
             epsilon = 1e-12
         );
