@@ -19,7 +19,9 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use carom::geometry::query::{Ray, RayCast, cast_ray, contact, distance, overlaps};
+use carom::geometry::query::{
+    Contact, Overlap, PointQuery, Ray, RayCast, cast_ray, contact, distance, overlaps,
+};
 use carom::geometry::{Aabb, Ball, HalfSpace, Obb, Real, Rotation, Space, Vector};
 use carom::math::nalgebra::Const;
 use criterion::measurement::WallTime;
@@ -145,7 +147,26 @@ fn run<I>(
     });
 }
 
-/// The parry side of one dimension: shapes with poses from the same specs.
+/// Runs the same carom query on the `f64` and `f32` inputs (the first two fields of each
+/// input tuple): `$x` is the pair of carom shapes in either precision.
+macro_rules! carom_runs {
+    ($g:expr, $input:expr, |$x:ident| $body:expr) => {
+        run($g, "carom_f64", $input, |($x, _, _)| $body);
+        run($g, "carom_f32", $input, |(_, $x, _)| $body);
+    };
+}
+
+/// The number a query's answer adds to the checksum: 1 for an overlap.
+fn flag(b: bool) -> f64 {
+    f64::from(u8::from(b))
+}
+
+/// The contact depth a carom contact adds to the checksum.
+fn depth<T: Real, const D: usize>(c: Option<Contact<T, D>>) -> f64 {
+    c.map_or(0.0, |c| c.depth.to_f64())
+}
+
+/// The benches of one dimension, with the parry crate of that dimension.
 macro_rules! parry_benches {
     ($name:ident, $parry:ident, $dim:literal, $pose:ident) => {
         mod $name {
@@ -153,7 +174,10 @@ macro_rules! parry_benches {
             use $parry::bounding_volume::BoundingVolume as _;
             use $parry::math::{Pose, Vector as PVector};
             use $parry::query::{self as pq, details as pd};
-            use $parry::shape::{Ball as PBall, Cuboid, HalfSpace as PHalfSpace};
+            use $parry::shape::{Ball as PBall, Cuboid, HalfSpace as PHalfSpace, Shape};
+
+            /// A pair of parry shapes with their poses.
+            type Pair<A, B> = ((Pose, A), (Pose, B));
 
             fn vector(v: &Vector<f64, $dim>) -> PVector {
                 PVector::from_slice(v.map(|x| x as f32).as_slice())
@@ -188,22 +212,71 @@ macro_rules! parry_benches {
                 )
             }
 
-            fn depth(c: Option<pq::Contact>) -> f64 {
-                c.map_or(0.0, |c| f64::from(c.dist))
+            /// parry's generic `intersection_test` on a pair.
+            fn parry_overlap<A: Shape, B: Shape>(((pa, a), (pb, b)): &Pair<A, B>) -> f64 {
+                flag(pq::intersection_test(pa, a, pb, b).unwrap().intersecting)
             }
 
-            fn flag(b: bool) -> f64 {
-                f64::from(u8::from(b))
+            /// parry's generic `contact` on a pair (prediction 0).
+            fn parry_contact<A: Shape, B: Shape>(((pa, a), (pb, b)): &Pair<A, B>) -> f64 {
+                parry_depth(pq::contact(pa, a, pb, b, 0.0).unwrap())
+            }
+
+            fn parry_depth(c: Option<pq::Contact>) -> f64 {
+                c.map_or(0.0, |c| f64::from(c.dist))
             }
 
             pub(super) fn benches(c: &mut Criterion) {
                 let dim = concat!($dim, "d");
                 let near = pairs::<$dim>(0xC0FFEE + $dim, 1.5);
                 ball_ball(c, dim, &near);
-                ball_boxes(c, dim, &near);
+                ball_box(
+                    c,
+                    dim,
+                    "aabb",
+                    &near,
+                    Spec::aabb::<f64>,
+                    Spec::aabb::<f32>,
+                    aabb,
+                );
+                ball_box(
+                    c,
+                    dim,
+                    "obb",
+                    &near,
+                    Spec::obb::<f64>,
+                    Spec::obb::<f32>,
+                    obb,
+                );
                 ball_half_space(c, dim, &near);
                 box_box(c, dim, &near);
-                rays(c, dim, &near);
+                ray_group(
+                    c,
+                    dim,
+                    "ray_ball",
+                    &near,
+                    Spec::ball::<f64>,
+                    Spec::ball::<f32>,
+                    ball,
+                );
+                ray_group(
+                    c,
+                    dim,
+                    "ray_aabb",
+                    &near,
+                    Spec::aabb::<f64>,
+                    Spec::aabb::<f32>,
+                    aabb,
+                );
+                ray_group(
+                    c,
+                    dim,
+                    "ray_obb",
+                    &near,
+                    Spec::obb::<f64>,
+                    Spec::obb::<f32>,
+                    obb,
+                );
             }
 
             /// Ball–ball overlap and contact.
@@ -219,20 +292,10 @@ macro_rules! parry_benches {
                     })
                     .collect();
                 let mut g = group(c, dim, "ball_ball_overlap");
-                run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                    flag(overlaps(&x.0, &x.1))
+                carom_runs!(&mut g, &input, |x| flag(overlaps(&x.0, &x.1)));
+                run(&mut g, "parry_generic", &input, |(_, _, p)| {
+                    parry_overlap(p)
                 });
-                run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                    flag(overlaps(&x.0, &x.1))
-                });
-                run(
-                    &mut g,
-                    "parry_generic",
-                    &input,
-                    |(_, _, ((pa, a), (pb, b)))| {
-                        flag(pq::intersection_test(pa, a, pb, b).unwrap().intersecting)
-                    },
-                );
                 run(
                     &mut g,
                     "parry_specific",
@@ -247,122 +310,87 @@ macro_rules! parry_benches {
                 );
                 g.finish();
                 let mut g = group(c, dim, "ball_ball_contact");
-                run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                    contact(&x.0, &x.1).map_or(0.0, |c| c.depth)
+                carom_runs!(&mut g, &input, |x| depth(contact(&x.0, &x.1)));
+                run(&mut g, "parry_generic", &input, |(_, _, p)| {
+                    parry_contact(p)
                 });
-                run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                    contact(&x.0, &x.1).map_or(0.0, |c| f64::from(c.depth))
-                });
-                run(
-                    &mut g,
-                    "parry_generic",
-                    &input,
-                    |(_, _, ((pa, a), (pb, b)))| depth(pq::contact(pa, a, pb, b, 0.0).unwrap()),
-                );
                 run(
                     &mut g,
                     "parry_specific",
                     &input,
                     |(_, _, ((pa, a), (pb, b)))| {
-                        depth(pd::contact_ball_ball(&pa.inv_mul(pb), a, b, 0.0))
+                        parry_depth(pd::contact_ball_ball(&pa.inv_mul(pb), a, b, 0.0))
                     },
                 );
                 g.finish();
             }
 
-            /// Ball–AABB and ball–OBB overlap and contact.
-            fn ball_boxes(c: &mut Criterion, dim: &str, near: &[(Spec<$dim>, Spec<$dim>)]) {
-                for (kind, rotated) in [("aabb", false), ("obb", true)] {
-                    let input: Vec<_> = near
-                        .iter()
-                        .map(|(a, b)| {
-                            let shape = if rotated { obb(b) } else { aabb(b) };
-                            (
-                                (a.ball::<f64>(), b.obb::<f64>(), b.aabb::<f64>()),
-                                (a.ball::<f32>(), b.obb::<f32>(), b.aabb::<f32>()),
-                                (ball(a), shape),
-                            )
-                        })
-                        .collect();
-                    let mut g = group(c, dim, &format!("ball_{kind}_overlap"));
-                    if rotated {
-                        run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                            flag(overlaps(&x.0, &x.1))
-                        });
-                        run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                            flag(overlaps(&x.0, &x.1))
-                        });
-                    } else {
-                        run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                            flag(overlaps(&x.0, &x.2))
-                        });
-                        run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                            flag(overlaps(&x.0, &x.2))
-                        });
-                    }
-                    run(
-                        &mut g,
-                        "parry_generic",
-                        &input,
-                        |(_, _, ((pa, a), (pb, b)))| {
-                            flag(pq::intersection_test(pa, a, pb, b).unwrap().intersecting)
-                        },
-                    );
-                    run(
-                        &mut g,
-                        "parry_specific",
-                        &input,
-                        |(_, _, ((pa, a), (pb, b)))| {
-                            flag(
-                                pd::intersection_test_ball_point_query(&pa.inv_mul(pb), a, b)
-                                    .intersecting,
-                            )
-                        },
-                    );
-                    g.finish();
-                    let mut g = group(c, dim, &format!("ball_{kind}_contact"));
-                    if rotated {
-                        run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                            contact(&x.0, &x.1).map_or(0.0, |c| c.depth)
-                        });
-                        run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                            contact(&x.0, &x.1).map_or(0.0, |c| f64::from(c.depth))
-                        });
-                    } else {
-                        run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                            contact(&x.0, &x.2).map_or(0.0, |c| c.depth)
-                        });
-                        run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                            contact(&x.0, &x.2).map_or(0.0, |c| f64::from(c.depth))
-                        });
-                    }
-                    run(
-                        &mut g,
-                        "parry_generic",
-                        &input,
-                        |(_, _, ((pa, a), (pb, b)))| depth(pq::contact(pa, a, pb, b, 0.0).unwrap()),
-                    );
-                    run(
-                        &mut g,
-                        "parry_specific",
-                        &input,
-                        |(_, _, ((pa, a), (pb, b)))| {
-                            depth(pd::contact_ball_convex_polyhedron(
-                                &pa.inv_mul(pb),
-                                a,
-                                b,
-                                0.0,
-                            ))
-                        },
-                    );
-                    g.finish();
-                }
+            /// Ball–box overlap and contact, for one kind of box (`aabb` or `obb`).
+            fn ball_box<S64, S32>(
+                c: &mut Criterion,
+                dim: &str,
+                kind: &str,
+                near: &[(Spec<$dim>, Spec<$dim>)],
+                carom64: impl Fn(&Spec<$dim>) -> S64,
+                carom32: impl Fn(&Spec<$dim>) -> S32,
+                parry: impl Fn(&Spec<$dim>) -> (Pose, Cuboid),
+            ) where
+                Ball<f64, $dim>: Overlap<S64>,
+                Ball<f32, $dim>: Overlap<S32>,
+                S64: PointQuery<f64, $dim>,
+                S32: PointQuery<f32, $dim>,
+            {
+                let input: Vec<_> = near
+                    .iter()
+                    .map(|(a, b)| {
+                        (
+                            (a.ball::<f64>(), carom64(b)),
+                            (a.ball::<f32>(), carom32(b)),
+                            (ball(a), parry(b)),
+                        )
+                    })
+                    .collect();
+                let mut g = group(c, dim, &format!("ball_{kind}_overlap"));
+                carom_runs!(&mut g, &input, |x| flag(overlaps(&x.0, &x.1)));
+                run(&mut g, "parry_generic", &input, |(_, _, p)| {
+                    parry_overlap(p)
+                });
+                run(
+                    &mut g,
+                    "parry_specific",
+                    &input,
+                    |(_, _, ((pa, a), (pb, b)))| {
+                        flag(
+                            pd::intersection_test_ball_point_query(&pa.inv_mul(pb), a, b)
+                                .intersecting,
+                        )
+                    },
+                );
+                g.finish();
+                let mut g = group(c, dim, &format!("ball_{kind}_contact"));
+                carom_runs!(&mut g, &input, |x| depth(contact(&x.0, &x.1)));
+                run(&mut g, "parry_generic", &input, |(_, _, p)| {
+                    parry_contact(p)
+                });
+                run(
+                    &mut g,
+                    "parry_specific",
+                    &input,
+                    |(_, _, ((pa, a), (pb, b)))| {
+                        parry_depth(pd::contact_ball_convex_polyhedron(
+                            &pa.inv_mul(pb),
+                            a,
+                            b,
+                            0.0,
+                        ))
+                    },
+                );
+                g.finish();
             }
 
-            /// Ball–half-space contact.
+            /// Ball–half-space contact. parry is asked half-space first: its
+            /// `contact(shape, half_space)` order has a pose bug in 0.31.
             fn ball_half_space(c: &mut Criterion, dim: &str, near: &[(Spec<$dim>, Spec<$dim>)]) {
-                // Ball–half-space contact. parry is asked half-space first: its
-                // `contact(shape, half_space)` order has a pose bug in 0.31.
                 let input: Vec<_> = near
                     .iter()
                     .map(|(a, b)| {
@@ -374,24 +402,16 @@ macro_rules! parry_benches {
                     })
                     .collect();
                 let mut g = group(c, dim, "ball_half_space_contact");
-                run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                    contact(&x.0, &x.1).map_or(0.0, |c| c.depth)
+                carom_runs!(&mut g, &input, |x| depth(contact(&x.0, &x.1)));
+                run(&mut g, "parry_generic", &input, |(_, _, p)| {
+                    parry_contact(p)
                 });
-                run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                    contact(&x.0, &x.1).map_or(0.0, |c| f64::from(c.depth))
-                });
-                run(
-                    &mut g,
-                    "parry_generic",
-                    &input,
-                    |(_, _, ((ph, h), (pb, b)))| depth(pq::contact(ph, h, pb, b, 0.0).unwrap()),
-                );
                 run(
                     &mut g,
                     "parry_specific",
                     &input,
                     |(_, _, ((ph, h), (pb, b)))| {
-                        depth(pd::contact_halfspace_support_map(
+                        parry_depth(pd::contact_halfspace_support_map(
                             &ph.inv_mul(pb),
                             h,
                             b,
@@ -407,38 +427,25 @@ macro_rules! parry_benches {
                 let input: Vec<_> = near
                     .iter()
                     .map(|(a, b)| {
-                        let pa = $parry::bounding_volume::Aabb::from_half_extents(
-                            vector(&a.center),
-                            vector(&a.size),
-                        );
-                        let pb = $parry::bounding_volume::Aabb::from_half_extents(
-                            vector(&b.center),
-                            vector(&b.size),
-                        );
+                        let bv = |s: &Spec<$dim>| {
+                            $parry::bounding_volume::Aabb::from_half_extents(
+                                vector(&s.center),
+                                vector(&s.size),
+                            )
+                        };
                         (
                             (a.aabb::<f64>(), b.aabb::<f64>()),
                             (a.aabb::<f32>(), b.aabb::<f32>()),
-                            (aabb(a), aabb(b)),
-                            (pa, pb),
+                            ((aabb(a), aabb(b)), (bv(a), bv(b))),
                         )
                     })
                     .collect();
                 let mut g = group(c, dim, "aabb_aabb_overlap");
-                run(&mut g, "carom_f64", &input, |(x, _, _, _)| {
-                    flag(overlaps(&x.0, &x.1))
+                carom_runs!(&mut g, &input, |x| flag(overlaps(&x.0, &x.1)));
+                run(&mut g, "parry_generic", &input, |(_, _, (p, _))| {
+                    parry_overlap(p)
                 });
-                run(&mut g, "carom_f32", &input, |(_, x, _, _)| {
-                    flag(overlaps(&x.0, &x.1))
-                });
-                run(
-                    &mut g,
-                    "parry_generic",
-                    &input,
-                    |(_, _, ((pa, a), (pb, b)), _)| {
-                        flag(pq::intersection_test(pa, a, pb, b).unwrap().intersecting)
-                    },
-                );
-                run(&mut g, "parry_specific", &input, |(_, _, _, (a, b))| {
+                run(&mut g, "parry_specific", &input, |(_, _, (_, (a, b)))| {
                     flag(a.intersects(b))
                 });
                 g.finish();
@@ -454,20 +461,10 @@ macro_rules! parry_benches {
                     })
                     .collect();
                 let mut g = group(c, dim, "obb_obb_overlap");
-                run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                    flag(overlaps(&x.0, &x.1))
+                carom_runs!(&mut g, &input, |x| flag(overlaps(&x.0, &x.1)));
+                run(&mut g, "parry_generic", &input, |(_, _, p)| {
+                    parry_overlap(p)
                 });
-                run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                    flag(overlaps(&x.0, &x.1))
-                });
-                run(
-                    &mut g,
-                    "parry_generic",
-                    &input,
-                    |(_, _, ((pa, a), (pb, b)))| {
-                        flag(pq::intersection_test(pa, a, pb, b).unwrap().intersecting)
-                    },
-                );
                 run(
                     &mut g,
                     "parry_specific",
@@ -478,12 +475,7 @@ macro_rules! parry_benches {
                 );
                 g.finish();
                 let mut g = group(c, dim, "obb_obb_distance");
-                run(&mut g, "carom_f64", &input, |(x, _, _)| {
-                    distance(&x.0, &x.1)
-                });
-                run(&mut g, "carom_f32", &input, |(_, x, _)| {
-                    f64::from(distance(&x.0, &x.1))
-                });
+                carom_runs!(&mut g, &input, |x| distance(&x.0, &x.1).to_f64());
                 run(
                     &mut g,
                     "parry_generic",
@@ -503,39 +495,9 @@ macro_rules! parry_benches {
                 g.finish();
             }
 
-            /// Ray casts against balls, AABBs and OBBs.
-            fn rays(c: &mut Criterion, dim: &str, near: &[(Spec<$dim>, Spec<$dim>)]) {
-                ray_group(
-                    c,
-                    dim,
-                    "ray_ball",
-                    near,
-                    Spec::ball::<f64>,
-                    Spec::ball::<f32>,
-                    ball,
-                );
-                ray_group(
-                    c,
-                    dim,
-                    "ray_aabb",
-                    near,
-                    Spec::aabb::<f64>,
-                    Spec::aabb::<f32>,
-                    aabb,
-                );
-                ray_group(
-                    c,
-                    dim,
-                    "ray_obb",
-                    near,
-                    Spec::obb::<f64>,
-                    Spec::obb::<f32>,
-                    obb,
-                );
-            }
-
             /// Ray casts against one kind of shape: carom in both precisions and parry's
-            /// `cast_ray_and_get_normal` on the concrete shape (solid).
+            /// `cast_ray_and_get_normal` on the concrete shape (solid). Rays start at a
+            /// random point along a random unit direction, with reach 10.
             fn ray_group<S64, S32, P>(
                 c: &mut Criterion,
                 dim: &str,
@@ -561,11 +523,8 @@ macro_rules! parry_benches {
                     })
                     .collect();
                 let mut g = group(c, dim, query);
-                run(&mut g, "carom_f64", &input, |((ray, s), _, _)| {
-                    cast_ray(s, ray, 10.0).map_or(0.0, |h| h.toi)
-                });
-                run(&mut g, "carom_f32", &input, |(_, (ray, s), _)| {
-                    cast_ray(s, ray, 10.0).map_or(0.0, |h| f64::from(h.toi))
+                carom_runs!(&mut g, &input, |x| {
+                    cast_ray(&x.1, &x.0, Real::lit(10.0)).map_or(0.0, |h| h.toi.to_f64())
                 });
                 run(
                     &mut g,

@@ -16,7 +16,7 @@ use carom::d2::{Aabb, Ball, BoundingSphere, HalfSpace, Obb, Vector};
 use carom::geometry::BoundingVolume;
 use carom::geometry::fit::{min_area_rect, minimal_sphere, pca_obb, ritter_sphere};
 use carom::geometry::query::{
-    PointQuery, Ray, RayCast, contact, overlaps, separation, signed_distance,
+    Distance, Overlap, PointQuery, Ray, RayCast, contact, overlaps, separation, signed_distance,
 };
 use carom::{d2, d3};
 
@@ -75,16 +75,20 @@ fn yes(b: bool) -> &'static str {
     if b { "yes" } else { "no" }
 }
 
-/// One row of the ball table: the ball against one other shape.
-fn ball_row(
+/// One row of the ball table: `ball` against `shape`. Any shape with point queries
+/// (ball, AABB, OBB, half-space) works: that is all a ball contact needs.
+fn ball_row<S>(
     out: &mut impl Write,
     name: &str,
     other: &str,
-    overlap: bool,
-    signed: f64,
-    c: Option<d2::Contact>,
-) -> io::Result<()> {
-    let contact = match c {
+    ball: &Ball,
+    shape: &S,
+) -> io::Result<()>
+where
+    S: PointQuery<f64, 2>,
+    Ball: Overlap<S> + Distance<f64, S>,
+{
+    let contact = match contact(ball, shape) {
         Some(c) => format!(
             "{:9.6}  {}  {}",
             tidy(c.depth),
@@ -98,8 +102,8 @@ fn ball_row(
         "  {:<10} {:<8} {:<8} {:>12.6}  {contact}",
         name,
         other,
-        yes(overlap),
-        tidy(signed)
+        yes(overlaps(ball, shape)),
+        tidy(signed_distance(ball, shape))
     )
 }
 
@@ -159,32 +163,11 @@ fn ball_table(out: &mut impl Write, scene: &Scene) -> io::Result<()> {
         "ball", "against", "overlaps", "signed dist", "depth", "normal", "point on shape"
     )?;
     for (name, ball) in &scene.balls {
-        ball_row(
-            out,
-            name,
-            "floor",
-            overlaps(ball, &scene.floor),
-            signed_distance(ball, &scene.floor),
-            contact(ball, &scene.floor),
-        )?;
-        ball_row(
-            out,
-            name,
-            "ramp",
-            overlaps(ball, &scene.ramp),
-            signed_distance(ball, &scene.ramp),
-            contact(ball, &scene.ramp),
-        )?;
+        ball_row(out, name, "floor", ball, &scene.floor)?;
+        ball_row(out, name, "ramp", ball, &scene.ramp)?;
         for (other_name, other) in &scene.balls {
             if other_name > name {
-                ball_row(
-                    out,
-                    name,
-                    other_name,
-                    overlaps(ball, other),
-                    signed_distance(ball, other),
-                    contact(ball, other),
-                )?;
+                ball_row(out, name, other_name, ball, other)?;
             }
         }
     }
