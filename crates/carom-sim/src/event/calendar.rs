@@ -4,18 +4,20 @@
 //! predicted event), so the calendar maps ball index → time and must support
 //! "schedule or reschedule ball i at t", "cancel ball i" and "pop the earliest".
 //!
-//! It follows Paul (J. Comput. Phys. 221, 2007): time is cut into buckets of width `w`.
-//! Events in the current bucket live in a small binary min-heap; events in the next
-//! `nb − 1` buckets live in unsorted doubly-linked lists (one per bucket, O(1) insert and
-//! remove); events further ahead live in an unsorted overflow list. Popping takes from
-//! the heap; when it runs dry the cursor moves to the next non-empty bucket, whose list
-//! is heapified. Every `nb` buckets the overflow list is redistributed. With `w` chosen
-//! so a bucket holds a few events, scheduling and popping cost O(1) on average plus a
-//! heap of a handful of entries, instead of O(log N) in one big heap.
+//! It follows Paul (J. Comput. Phys. 221, 2007): time is cut into buckets of width `w`,
+//! and `nb` consecutive buckets form a *cycle*. Events in the current bucket live in a
+//! small binary min-heap; events in the rest of the cycle live in unsorted
+//! doubly-linked lists (one per bucket, O(1) insert and remove); events beyond the cycle
+//! live in an unsorted overflow list. Popping takes from the heap; when it runs dry the
+//! cursor moves to the next non-empty bucket, whose list is heapified. When the cycle is
+//! used up the next one starts and the overflow is redistributed — once per cycle, so
+//! each event is looked at O(1) times per cycle. With `w` chosen so a bucket holds a few
+//! events, scheduling and popping cost O(1) on average plus a heap of a handful of
+//! entries, instead of O(log N) in one big heap.
 //!
 //! Ties are broken by ball index, so the order of events is deterministic.
 
-use carom_math::Real;
+use carom_math::{Real, floor_to_i64};
 
 const NONE: u32 = u32::MAX;
 
@@ -46,9 +48,9 @@ pub struct Calendar<T: Real> {
     inv_width: T,
     /// Absolute index of the bucket the heap holds (bucket k spans `[k w, (k+1) w)`).
     current: i64,
-    /// A lower bound of the buckets of the overflow events (exact after a
-    /// redistribution; a cancel may leave it low, which only redistributes early).
-    overflow_min: i64,
+    /// The first bucket after the current cycle: lists hold buckets in
+    /// `(current, cycle_end)`, the overflow holds buckets `>= cycle_end`.
+    cycle_end: i64,
     len: usize,
 }
 
@@ -72,10 +74,11 @@ impl<T: Real> Calendar<T> {
             overflow: Vec::new(),
             inv_width: T::one() / width,
             current: 0,
-            overflow_min: i64::MAX,
+            cycle_end: 0,
             len: 0,
         };
         c.current = c.bucket_of(start);
+        c.cycle_end = c.current.saturating_add(buckets as i64);
         c
     }
 
@@ -109,8 +112,8 @@ impl<T: Real> Calendar<T> {
     }
 
     fn bucket_of(&self, t: T) -> i64 {
-        // `as` saturates: times far beyond the range land in the overflow list.
-        (t * self.inv_width).floor().to_f64() as i64
+        // Saturating: times far beyond the range land in the overflow list.
+        floor_to_i64(t * self.inv_width)
     }
 
     /// Schedules `ball` at time `t`, replacing its previous event. An infinite `t` cancels.
@@ -162,51 +165,49 @@ impl<T: Real> Calendar<T> {
     /// Puts a ball whose time is set into the heap, a bucket or the overflow list.
     fn place(&mut self, ball: u32) {
         let k = self.bucket_of(self.time[ball as usize]);
-        let nb = self.heads.len() as i64;
         if k <= self.current {
             self.heap_push(ball);
-        } else if k - self.current < nb {
-            self.list_push(ball, k.rem_euclid(nb) as usize);
+        } else if k < self.cycle_end {
+            self.list_push(ball, k.rem_euclid(self.heads.len() as i64) as usize);
         } else {
             self.slot[ball as usize] = Slot::Overflow(self.overflow.len() as u32);
             self.overflow.push(ball);
-            self.overflow_min = self.overflow_min.min(k);
         }
     }
 
     /// Moves the cursor forward until the heap holds the earliest events.
     ///
     /// Invariant: heap events are in buckets `<= current`, list events in
-    /// `(current, current + nb)`, overflow events in `>= current + nb` — restored here by
-    /// redistributing the overflow before the window can reach it.
+    /// `(current, cycle_end)`, overflow events in `>= cycle_end`.
     fn refill(&mut self) {
         if !self.heap.is_empty() || self.len == 0 {
             return;
         }
         let nb = self.heads.len() as i64;
         loop {
-            if self.overflow_min < self.current.saturating_add(nb) {
-                self.redistribute_overflow();
-                if !self.heap.is_empty() {
-                    return;
-                }
-            }
-            for step in 1..nb {
-                let k = self.current + step;
+            let mut k = self.current + 1;
+            while k < self.cycle_end {
                 let b = k.rem_euclid(nb) as usize;
                 if self.heads[b] != NONE {
                     self.current = k;
                     self.drain_bucket_into_heap(b);
                     return;
                 }
+                k += 1;
             }
-            // The window is empty: jump to the earliest overflow bucket.
+            // The cycle is used up: the next one starts at the earliest overflow event
+            // (skipping empty cycles), and the overflow is redistributed once.
             let earliest = self
                 .overflow
                 .iter()
                 .map(|&b| self.time[b as usize])
                 .fold(T::INFINITY, T::min);
-            self.current = self.bucket_of(earliest);
+            debug_assert!(
+                earliest < T::INFINITY,
+                "events are counted but none is stored"
+            );
+            self.current = self.bucket_of(earliest).max(self.cycle_end);
+            self.cycle_end = self.current.saturating_add(nb);
             self.redistribute_overflow();
             if !self.heap.is_empty() {
                 return;
@@ -226,10 +227,9 @@ impl<T: Real> Calendar<T> {
         }
     }
 
-    /// Places every overflow event again relative to the current bucket.
+    /// Places every overflow event again relative to the current cycle.
     fn redistribute_overflow(&mut self) {
         let pending = std::mem::take(&mut self.overflow);
-        self.overflow_min = i64::MAX;
         for &ball in &pending {
             self.place(ball);
         }

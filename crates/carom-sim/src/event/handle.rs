@@ -21,7 +21,11 @@ where
     Const<D>: Space<T, D>,
 {
     /// Processes ball `i`'s pending event at the current time.
-    pub(crate) fn handle(&mut self, i: usize, observer: &mut dyn Observer<T>) -> Result<(), SimError> {
+    pub(crate) fn handle(
+        &mut self,
+        i: usize,
+        observer: &mut dyn Observer<T>,
+    ) -> Result<(), SimError> {
         let now = self.now;
         match self.pending[i] {
             Pending::None => {}
@@ -97,7 +101,9 @@ where
     /// support normal still matches the support's; otherwise it flies (and if it now
     /// presses into the support, the next prediction finds that contact at once).
     fn check_support(&mut self, i: usize) {
-        let Mode::Resting(support) = self.balls.mode[i] else { return };
+        let Mode::Resting(support) = self.balls.mode[i] else {
+            return;
+        };
         let (n, support_velocity) = self.support_frame(support);
         if (self.balls.vel[i] - support_velocity).dot(&n) != T::zero() {
             self.free(i);
@@ -135,9 +141,17 @@ where
         let (a, b) = (self.body(i), self.body(j));
         let approach = -normal_velocity(&a, &b, &contact);
         let nominal = self.ball_restitution(i).min(self.ball_restitution(j));
-        let since = [self.now - self.balls.last_collision[i], self.now - self.balls.last_collision[j]];
+        let since = [
+            self.now - self.balls.last_collision[i],
+            self.now - self.balls.last_collision[j],
+        ];
         let e = self.collapse.restitution(nominal, approach, since);
-        let response = resolve(&a, &b, &contact, &Coefficients::new_unchecked(e, self.friction));
+        let response = resolve(
+            &a,
+            &b,
+            &contact,
+            &Coefficients::new_unchecked(e, self.friction),
+        );
         if !response.applied() {
             return;
         }
@@ -150,7 +164,11 @@ where
         self.check_support(i);
         self.check_support(j);
         self.counters.ball_ball += 1;
-        observer.collision(&Collision::BallBall { time: self.now * self.sign, i: i.min(j), j: i.max(j) });
+        observer.collision(&Collision::BallBall {
+            time: self.now * self.sign,
+            i: i.min(j),
+            j: i.max(j),
+        });
     }
 
     /// The ball's restitution in ball–ball collisions: its own or the world's.
@@ -177,9 +195,11 @@ where
         support: Option<Support>,
     ) -> bool {
         let r = self.balls.radius[i];
-        let contact = Contact::new_unchecked(normal, normal * r, point - self.balls.pos[i] - normal * r);
+        let contact =
+            Contact::new_unchecked(normal, normal * r, point - self.balls.pos[i] - normal * r);
         let a = self.body(i);
-        let b = Body::kinematic(surface_velocity, <Const<D> as Space<T, D>>::angular_zero()).unwrap_or_else(|_| Body::fixed());
+        let b = Body::kinematic(surface_velocity, <Const<D> as Space<T, D>>::angular_zero())
+            .unwrap_or_else(|_| Body::fixed());
         let approach = -normal_velocity(&a, &b, &contact);
         let mut e = self.surface_restitution(i, surface_restitution);
         let pressing = self.gravity.dot(&normal);
@@ -187,7 +207,12 @@ where
         if rest {
             e = T::zero();
         }
-        let response = resolve(&a, &b, &contact, &Coefficients::new_unchecked(e, self.friction));
+        let response = resolve(
+            &a,
+            &b,
+            &contact,
+            &Coefficients::new_unchecked(e, self.friction),
+        );
         if !response.applied() {
             return false;
         }
@@ -213,11 +238,25 @@ where
         let mut normal = Vector::<T, D>::zeros();
         normal[axis] = if upper { T::one() } else { -T::one() };
         let mut point = self.balls.pos[i];
-        point[axis] = if upper { border.max()[axis] } else { border.min()[axis] };
+        point[axis] = if upper {
+            border.max()[axis]
+        } else {
+            border.min()[axis]
+        };
         let support = Some(Support::Wall { axis, upper });
-        if self.bounce(i, normal, point, Vector::zeros(), self.border_restitution, support) {
+        if self.bounce(
+            i,
+            normal,
+            point,
+            Vector::zeros(),
+            self.border_restitution,
+            support,
+        ) {
             self.counters.ball_border += 1;
-            observer.collision(&Collision::BallBorder { time: self.now * self.sign, i });
+            observer.collision(&Collision::BallBorder {
+                time: self.now * self.sign,
+                i,
+            });
         }
     }
 
@@ -239,10 +278,18 @@ where
         for m in (0..D).filter(|&m| local[m].abs() > h[m]) {
             outside = (outside.0 + 1, m);
         }
-        let support = (outside.0 == 1).then(|| Support::BoxFace { k, axis: outside.1, upper: local[outside.1] > T::zero() });
+        let support = (outside.0 == 1).then(|| Support::BoxFace {
+            k,
+            axis: outside.1,
+            upper: local[outside.1] > T::zero(),
+        });
         if self.bounce(i, normal, point, b.vel, b.restitution, support) {
             self.counters.ball_box += 1;
-            observer.collision(&Collision::BallBox { time: self.now * self.sign, i, k });
+            observer.collision(&Collision::BallBox {
+                time: self.now * self.sign,
+                i,
+                k,
+            });
         }
     }
 }

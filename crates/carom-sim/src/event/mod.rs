@@ -69,7 +69,11 @@ pub(crate) struct BoxBody<T: Real, const D: usize> {
 impl<T: Real, const D: usize> BoxBody<T, D> {
     /// The box at internal time `t`.
     pub(crate) fn at(&self, t: T) -> Obb<T, D> {
-        if self.vel == Vector::zeros() { self.shape } else { self.shape.translated(&(self.vel * t)) }
+        if self.vel.iter().all(|x| *x == T::zero()) {
+            self.shape
+        } else {
+            self.shape.translated(&(self.vel * t))
+        }
     }
 }
 
@@ -149,7 +153,10 @@ where
     pub fn new(scene: &Scene<T, D>, plan: &Plan, direction: Direction) -> Result<Self, SceneError> {
         scene.validate()?;
         if let Some(why) = crate::plan::event_engine_limitation(scene) {
-            return Err(SceneError::new("", format!("the event-driven engine cannot run this scene: {why}")));
+            return Err(SceneError::new(
+                "",
+                format!("the event-driven engine cannot run this scene: {why}"),
+            ));
         }
         let sign = direction.sign::<T>();
         let n = scene.balls.len();
@@ -174,7 +181,11 @@ where
         };
         let r_min = balls.radius.iter().copied().fold(T::INFINITY, T::min);
         let r_max = balls.radius.iter().copied().fold(T::zero(), T::max);
-        let r_mean = if n == 0 { T::one() } else { balls.radius.iter().copied().fold(T::zero(), |a, b| a + b) / T::from_count(n) };
+        let r_mean = if n == 0 {
+            T::one()
+        } else {
+            balls.radius.iter().copied().fold(T::zero(), |a, b| a + b) / T::from_count(n)
+        };
         let shell = r_mean * T::lit(SHELL_PER_RADIUS);
         let use_lists = match plan.broad {
             BroadChoice::Brute => false,
@@ -183,11 +194,22 @@ where
         };
         let partners = if use_lists && n > 1 {
             let domain = match (&border, periodic) {
-                (Some(b), true) => Domain::Periodic { min: b.min(), max: b.max() },
-                (Some(b), false) => Domain::Bounded { min: b.min(), max: b.max() },
+                (Some(b), true) => Domain::Periodic {
+                    min: b.min(),
+                    max: b.max(),
+                },
+                (Some(b), false) => Domain::Bounded {
+                    min: b.min(),
+                    max: b.max(),
+                },
                 (None, _) => Domain::Unbounded,
             };
-            Partners::Lists(NeighbourLists::new(&balls.pos, &balls.radius, shell, domain))
+            Partners::Lists(NeighbourLists::new(
+                &balls.pos,
+                &balls.radius,
+                shell,
+                domain,
+            ))
         } else {
             Partners::All
         };
@@ -198,7 +220,11 @@ where
             if let Some(k) = (0..D).find(|&k| b.extents()[k] <= reach * T::lit(2.0)) {
                 return Err(SceneError::new(
                     "world.border",
-                    format!("a periodic box must be longer than {} on every axis (axis {k} is {})", reach * T::lit(2.0), b.extents()[k]),
+                    format!(
+                        "a periodic box must be longer than {} on every axis (axis {k} is {})",
+                        reach * T::lit(2.0),
+                        b.extents()[k]
+                    ),
                 ));
             }
         }
@@ -206,16 +232,35 @@ where
         let rms = if n == 0 {
             T::zero()
         } else {
-            (balls.vel.iter().map(|v| v.norm_squared()).fold(T::zero(), |a, b| a + b) / T::from_count(n)).sqrt()
+            (balls
+                .vel
+                .iter()
+                .map(|v| v.norm_squared())
+                .fold(T::zero(), |a, b| a + b)
+                / T::from_count(n))
+            .sqrt()
         };
         let r_scale = if r_min.finite() { r_min } else { T::one() };
         let v_scale = rms.max((g * r_scale).sqrt()).max(T::MIN_POSITIVE.sqrt());
-        let collapse = CollapseGuard::tc_model((T::lit(1e-9) * r_scale / v_scale).max(T::MIN_POSITIVE))
-            .map_err(|e| SceneError::new("", format!("collapse guard: {e}")))?;
-        let flight = if g > T::zero() { T::lit(1e-6) * (r_scale / g).sqrt() } else { T::one() };
-        let resting = RestingGuard::new(flight.max(T::MIN_POSITIVE)).map_err(|e| SceneError::new("", format!("resting guard: {e}")))?;
-        let boxes: Vec<BoxBody<T, D>> =
-            scene.boxes.iter().map(|b| BoxBody { shape: b.shape, vel: b.vel * sign, restitution: b.restitution }).collect();
+        let collapse =
+            CollapseGuard::tc_model((T::lit(1e-9) * r_scale / v_scale).max(T::MIN_POSITIVE))
+                .map_err(|e| SceneError::new("", format!("collapse guard: {e}")))?;
+        let flight = if g > T::zero() {
+            T::lit(1e-6) * (r_scale / g).sqrt()
+        } else {
+            T::one()
+        };
+        let resting = RestingGuard::new(flight.max(T::MIN_POSITIVE))
+            .map_err(|e| SceneError::new("", format!("resting guard: {e}")))?;
+        let boxes: Vec<BoxBody<T, D>> = scene
+            .boxes
+            .iter()
+            .map(|b| BoxBody {
+                shape: b.shape,
+                vel: b.vel * sign,
+                restitution: b.restitution,
+            })
+            .collect();
         let mut engine = Self {
             sign,
             gravity: scene.world.gravity,
@@ -238,30 +283,35 @@ where
             pipeline: Vec::new(),
         };
         engine.pipeline = engine.describe(scene);
-        engine.size_calendar();
-        for i in 0..n {
-            engine.predict(i);
-        }
+        engine.schedule_all();
         Ok(engine)
     }
 
-    /// Sizes the calendar's buckets from the first predictions: the mean time to each
-    /// ball's next event sets the spread of the events.
-    fn size_calendar(&mut self) {
+    /// Predicts every ball, then sizes the calendar's buckets from the predictions (the
+    /// mean time to a ball's next event sets how events spread) and moves them into it.
+    fn schedule_all(&mut self) {
         let n = self.balls.len();
-        let mut sum = T::zero();
-        let mut count = 0usize;
         for i in 0..n {
             self.predict(i);
+        }
+        let (mut sum, mut count) = (T::zero(), 0usize);
+        for i in 0..n {
             let t = self.calendar.time_of(i);
             if t.finite() {
                 sum += t - self.now;
                 count += 1;
             }
         }
-        let horizon = if count > 0 { sum / T::from_count(count) } else { T::one() };
-        self.calendar = Calendar::sized_for(n, horizon.max(T::MIN_POSITIVE), self.now);
-        self.pending.fill(Pending::None);
+        let horizon = if count > 0 {
+            sum / T::from_count(count)
+        } else {
+            T::one()
+        };
+        let mut sized = Calendar::sized_for(n, horizon.max(T::MIN_POSITIVE), self.now);
+        for i in 0..n {
+            sized.schedule(i, self.calendar.time_of(i));
+        }
+        self.calendar = sized;
     }
 
     /// The components this scene uses.
@@ -283,14 +333,19 @@ where
         if !self.boxes.is_empty() {
             p.push("toi:ball-box".to_owned());
         }
-        if self.gravity != Vector::zeros() {
+        if self.gravity.iter().any(|x| *x != T::zero()) {
             p.push("motion:ballistic".to_owned());
             p.push("guard:resting".to_owned());
         } else {
             p.push("motion:linear".to_owned());
         }
-        p.push(if self.friction > T::zero() { "response:restitution+friction".to_owned() } else { "response:restitution".to_owned() });
-        let inelastic_pairs = (0..scene.balls.len()).any(|i| scene.balls[i].restitution.unwrap_or(self.world_restitution) < T::one());
+        p.push(if self.friction > T::zero() {
+            "response:restitution+friction".to_owned()
+        } else {
+            "response:restitution".to_owned()
+        });
+        let inelastic_pairs = (0..scene.balls.len())
+            .any(|i| scene.balls[i].restitution.unwrap_or(self.world_restitution) < T::one());
         if self.stick && inelastic_pairs {
             p.push("response:stick".to_owned());
         }
@@ -307,7 +362,11 @@ where
     }
 
     fn periodic_border(&self) -> Option<&Border<T, D>> {
-        if self.periodic { self.border.as_ref() } else { None }
+        if self.periodic {
+            self.border.as_ref()
+        } else {
+            None
+        }
     }
 
     /// The separation `b − a` (minimum image in a periodic box).
@@ -326,7 +385,13 @@ where
             Some(b) => b.wrap(&p),
             None => p,
         };
-        (p, self.balls.velocity_at(i, self.now) * self.sign)
+        // `+ 0` turns the `−0` of a negated zero into `0`.
+        (
+            p,
+            self.balls
+                .velocity_at(i, self.now)
+                .map(|x| x * self.sign + T::zero()),
+        )
     }
 }
 
@@ -351,7 +416,10 @@ where
         if target < self.now {
             return Err(SimError {
                 time: (self.now * self.sign).to_f64(),
-                message: format!("cannot advance to {} which is behind the current time", (target * self.sign).to_f64()),
+                message: format!(
+                    "cannot advance to {} which is behind the current time",
+                    (target * self.sign).to_f64()
+                ),
             });
         }
         let mut processed: u64 = 0;
@@ -391,7 +459,8 @@ where
             let (p, v) = self.reported_state(i);
             out.pos.push(p);
             out.vel.push(v);
-            out.spin.push(self.balls.spin[i] * self.sign);
+            out.spin
+                .push(self.balls.spin[i] * self.sign + <Const<D> as Space<T, D>>::angular_zero());
         }
     }
 

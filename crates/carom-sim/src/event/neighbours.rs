@@ -18,7 +18,8 @@
 //! Very mixed radii make the cells (sized by the largest ball) hold many small balls;
 //! the lists stay exact, only rebuilds get slower.
 
-use carom_math::{Real, Vector};
+use carom_geometry::Border;
+use carom_math::{Real, Vector, floor_to_i64};
 
 const NONE: u32 = u32::MAX;
 
@@ -63,7 +64,8 @@ pub struct NeighbourLists<T: Real, const D: usize> {
     /// Inverse cell width per axis (periodic axes are tiled exactly by their cells).
     inv_cell: Vector<T, D>,
     cells: Cells<T, D>,
-    period: Option<Vector<T, D>>,
+    /// The periodic box, for minimum images.
+    period: Option<Border<T, D>>,
     heads: Vec<u32>,
     next: Vec<u32>,
     prev: Vec<u32>,
@@ -108,7 +110,8 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
                         counts,
                         periodic,
                     },
-                    periodic.then_some(ext),
+                    periodic
+                        .then(|| Border::new(min, max).expect("a periodic domain is a valid box")),
                     total as usize,
                     width,
                 )
@@ -163,10 +166,9 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
     /// The separation `b − a`, as the minimum image in a periodic domain.
     #[inline]
     pub fn separation(&self, a: &Vector<T, D>, b: &Vector<T, D>) -> Vector<T, D> {
-        let d = b - a;
         match &self.period {
-            Some(len) => Vector::<T, D>::from_fn(|k, _| d[k] - len[k] * (d[k] / len[k]).round()),
-            None => d,
+            Some(border) => border.minimum_image(&(b - a)),
+            None => b - a,
         }
     }
 
@@ -236,7 +238,7 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
         // Saturating casts keep far-away points finite. In a bounded domain the edge
         // cells extend to infinity, so coordinates are clamped to the grid.
         core::array::from_fn(|k| {
-            let c = ((p[k] - origin[k]) * self.inv_cell[k]).floor().to_f64() as i64;
+            let c = floor_to_i64((p[k] - origin[k]) * self.inv_cell[k]);
             match &self.cells {
                 Cells::Direct {
                     counts,

@@ -51,25 +51,40 @@ where
         }
         let ball = self.ball_at(i, now);
         let kin = Kinematics::new_unchecked(self.balls.velocity_at(i, now), self.balls.accel[i]);
-        let window = |best_t: T| Window::forward(best_t - now).unwrap_or_else(|_| Window::forward(T::zero()).expect("0 is a valid horizon"));
+        let window = |best_t: T| {
+            Window::forward(best_t - now)
+                .unwrap_or_else(|_| Window::forward(T::zero()).expect("0 is a valid horizon"))
+        };
         if let (Some(border), false) = (&self.border, self.periodic) {
             let toi = ball_border(&ball, &kin, border, &window(best_t));
             if let Some(s) = toi.hit_time()
                 && now + s < best_t
             {
                 best_t = now + s;
-                best = Pending::Wall { axis: toi.feature.axis as u8, upper: toi.feature.side == carom_toi::Side::Upper };
+                best = Pending::Wall {
+                    axis: toi.feature.axis as u8,
+                    upper: toi.feature.side == carom_toi::Side::Upper,
+                };
             }
         }
         for (k, b) in self.boxes.iter().enumerate() {
             let obb = b.at(now);
             // In a periodic box, the image of the ball nearest the box.
             let image = if self.periodic {
-                carom_geometry::Ball::new_unchecked(obb.center() - self.separation(&ball.center(), &obb.center()), ball.radius())
+                carom_geometry::Ball::new_unchecked(
+                    obb.center() - self.separation(&ball.center(), &obb.center()),
+                    ball.radius(),
+                )
             } else {
                 ball
             };
-            let toi = ball_obb(&image, &kin, &obb, &Kinematics::new_unchecked(b.vel, Vector::zeros()), &window(best_t));
+            let toi = ball_obb(
+                &image,
+                &kin,
+                &obb,
+                &Kinematics::new_unchecked(b.vel, Vector::zeros()),
+                &window(best_t),
+            );
             if let Some(s) = toi.hit_time()
                 && now + s < best_t
             {
@@ -77,19 +92,26 @@ where
                 best = Pending::Box { k: k as u32 };
             }
         }
-        let mut consider = |j: usize, best_t: &mut T, best: &mut Pending| {
+        let consider = |j: usize, best_t: &mut T, best: &mut Pending| {
             if j == i || matches!(self.balls.mode[j], Mode::Stuck(_)) {
                 return;
             }
             let pj = self.balls.position_at(j, now);
-            let other = carom_geometry::Ball::new_unchecked(ball.center() + self.separation(&ball.center(), &pj), self.balls.radius[j]);
-            let kin_j = Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel[j]);
+            let other = carom_geometry::Ball::new_unchecked(
+                ball.center() + self.separation(&ball.center(), &pj),
+                self.balls.radius[j],
+            );
+            let kin_j =
+                Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel[j]);
             let toi = ball_ball(&ball, &kin, &other, &kin_j, &window(*best_t));
             if let Some(s) = toi.hit_time()
                 && now + s < *best_t
             {
                 *best_t = now + s;
-                *best = Pending::Ball { j: j as u32, count: self.balls.count[j] };
+                *best = Pending::Ball {
+                    j: j as u32,
+                    count: self.balls.count[j],
+                };
             }
         };
         match &self.partners {
@@ -144,7 +166,12 @@ where
 /// root is `(−b + √Δ)/|v|²`, equal to `−c / (b + √Δ)` when `b > 0`. With acceleration,
 /// the bound `|d| + |v| s + |a| s²/2 = ρ` gives a time at which the point is certainly
 /// still inside: `s = 2 (ρ − |d|) / (|v| + √(|v|² + 2 |a| (ρ − |d|)))`.
-pub(crate) fn exit_time<T: Real, const D: usize>(d: &Vector<T, D>, v: &Vector<T, D>, a: &Vector<T, D>, radius: T) -> T {
+pub(crate) fn exit_time<T: Real, const D: usize>(
+    d: &Vector<T, D>,
+    v: &Vector<T, D>,
+    a: &Vector<T, D>,
+    radius: T,
+) -> T {
     let room = radius - d.norm();
     if room <= T::zero() {
         return T::zero();
@@ -157,7 +184,11 @@ pub(crate) fn exit_time<T: Real, const D: usize>(d: &Vector<T, D>, v: &Vector<T,
         let b = d.dot(v);
         let c = (d.norm() - radius) * (d.norm() + radius);
         let root = (b * b - vv * c).max(T::zero()).sqrt();
-        return if b > T::zero() { -c / (b + root) } else { (root - b) / vv };
+        return if b > T::zero() {
+            -c / (b + root)
+        } else {
+            (root - b) / vv
+        };
     }
     let (speed, accel) = (v.norm(), a.norm());
     let two = T::lit(2.0);
@@ -171,11 +202,17 @@ mod tests {
 
     #[test]
     fn exit_time_is_exact_without_acceleration_and_conservative_with_it() {
-        let z = Vector2::zeros();
+        let z = Vector2::<f64>::zeros();
         assert_eq!(exit_time(&z, &Vector2::new(2.0, 0.0), &z, 1.0), 0.5);
         // Starting at 0.6 moving away and towards: 0.4 and 1.6 to the circle.
-        assert!((exit_time(&Vector2::new(0.6, 0.0), &Vector2::new(1.0, 0.0), &z, 1.0) - 0.4).abs() < 1e-15);
-        assert!((exit_time(&Vector2::new(0.6, 0.0), &Vector2::new(-1.0, 0.0), &z, 1.0) - 1.6).abs() < 1e-15);
+        assert!(
+            (exit_time(&Vector2::new(0.6, 0.0), &Vector2::new(1.0, 0.0), &z, 1.0) - 0.4).abs()
+                < 1e-15
+        );
+        assert!(
+            (exit_time(&Vector2::new(0.6, 0.0), &Vector2::new(-1.0, 0.0), &z, 1.0) - 1.6).abs()
+                < 1e-15
+        );
         assert_eq!(exit_time(&z, &z, &z, 1.0), f64::INFINITY);
         assert_eq!(exit_time(&Vector2::new(2.0, 0.0), &z, &z, 1.0), 0.0);
         // Falling from rest under g = 2: |d| = s² reaches 1 at s = 1; the bound is exact here.
