@@ -1,5 +1,6 @@
 //! `carom run`: load a scene file, plan, build the engine, run it, print JSON Lines.
 
+use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{self, BufWriter, IsTerminal, Write};
 use std::path::PathBuf;
@@ -214,10 +215,11 @@ impl JsonSink {
             }
             json::string(l, p);
         }
-        l.push_str(&format!(
+        let _ = write!(
+            l,
             "], \"ball_ball\": {}, \"ball_border\": {}, \"ball_box\": {}, \"energy_initial\": ",
             s.counters.ball_ball, s.counters.ball_border, s.counters.ball_box
-        ));
+        );
         s.energy_initial.write_json(l);
         l.push_str(", \"energy_final\": ");
         s.energy_final.write_json(l);
@@ -254,17 +256,17 @@ where
             Collision::BallBall { time, i, j } => {
                 l.push_str("{\"event\": \"ball-ball\", \"t\": ");
                 time.write_json(l);
-                l.push_str(&format!(", \"i\": {i}, \"j\": {j}}}"));
+                let _ = write!(l, ", \"i\": {i}, \"j\": {j}}}");
             }
             Collision::BallBorder { time, i } => {
                 l.push_str("{\"event\": \"ball-border\", \"t\": ");
                 time.write_json(l);
-                l.push_str(&format!(", \"i\": {i}}}"));
+                let _ = write!(l, ", \"i\": {i}}}");
             }
             Collision::BallBox { time, i, k } => {
                 l.push_str("{\"event\": \"ball-box\", \"t\": ");
                 time.write_json(l);
-                l.push_str(&format!(", \"i\": {i}, \"box\": {k}}}"));
+                let _ = write!(l, ", \"i\": {i}, \"box\": {k}}}");
             }
         }
         self.emit();

@@ -125,10 +125,26 @@ pub fn event_engine_limitation<T: Real, const D: usize>(
     if scene.world.drag > T::zero() {
         return Some("the scene has drag, which has no exact time of impact");
     }
-    if D == 3 && scene.world.inelastic == Inelastic::Stick && scene.world.restitution == T::zero() {
-        return Some(
-            "stuck clusters tumble in 3D (torque-free precession), which has no closed form",
-        );
+    let stick = scene.world.inelastic == Inelastic::Stick
+        && (scene.world.restitution == T::zero()
+            || scene.balls.iter().any(|b| b.restitution == Some(T::zero())));
+    if stick {
+        if D == 3 {
+            return Some(
+                "stuck clusters tumble in 3D (torque-free precession), which has no closed form",
+            );
+        }
+        if scene.world.gravity.iter().any(|g| *g != T::zero()) {
+            return Some(
+                "stuck clusters under gravity would need resting rigid bodies, which the event engine does not model",
+            );
+        }
+        if !scene.boxes.is_empty() {
+            return Some("stuck clusters against boxes have no exact contact search in carom-toi");
+        }
+        if scene.world.border.is_some_and(|b| b.periodic) {
+            return Some("stuck clusters in a periodic box are not supported by the event engine");
+        }
     }
     None
 }

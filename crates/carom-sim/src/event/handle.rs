@@ -20,15 +20,28 @@ impl<T: Real, const D: usize> EventEngine<T, D>
 where
     Const<D>: Space<T, D>,
 {
-    /// Processes ball `i`'s pending event at the current time.
+    /// Processes the pending event of calendar slot `i` (a ball, or a cluster after the
+    /// balls) at the current time.
     pub(crate) fn handle(
         &mut self,
         i: usize,
         observer: &mut dyn Observer<T>,
     ) -> Result<(), SimError> {
         let now = self.now;
+        if i >= self.balls.len() {
+            return self.handle_cluster(i - self.balls.len(), observer);
+        }
         match self.pending[i] {
             Pending::None => {}
+            Pending::Recheck => self.predict(i),
+            Pending::Cluster { c, count } => {
+                let c = c as usize;
+                if self.clusters[c].alive && self.clusters[c].count == count {
+                    self.ball_meets_cluster(i, c, observer)?;
+                } else {
+                    self.predict(i);
+                }
+            }
             Pending::Rebuild => {
                 let periodic = self.periodic_border().copied();
                 self.balls.sync(i, now, periodic.as_ref());
@@ -38,7 +51,7 @@ where
                 self.predict(i);
             }
             Pending::LeaveSupport => {
-                self.sync(i);
+                self.sync_ball(i);
                 self.free(i);
                 self.predict(i);
             }
@@ -46,6 +59,17 @@ where
                 let j = j as usize;
                 if self.balls.count[j] != count || matches!(self.balls.mode[j], Mode::Stuck(_)) {
                     self.predict(i);
+                } else if self.sticks(i, j) {
+                    self.sync_ball(i);
+                    self.sync_ball(j);
+                    let c = self.stick_balls(i, j)?;
+                    self.counters.ball_ball += 1;
+                    observer.collision(&Collision::BallBall {
+                        time: self.now * self.sign,
+                        i: i.min(j),
+                        j: i.max(j),
+                    });
+                    self.predict_cluster(c);
                 } else {
                     self.collide_balls(i, j, observer);
                     self.predict(i);
@@ -64,13 +88,18 @@ where
         Ok(())
     }
 
-    fn sync(&mut self, i: usize) {
+    /// `true` if balls `i` and `j` stick: restitution 0 in a "stick" world.
+    fn sticks(&self, i: usize, j: usize) -> bool {
+        self.stick && self.ball_restitution(i).min(self.ball_restitution(j)) == T::zero()
+    }
+
+    pub(crate) fn sync_ball(&mut self, i: usize) {
         let periodic = self.periodic_border().copied();
         self.balls.sync(i, self.now, periodic.as_ref());
     }
 
     /// Ball `i` as a carom-response body (synchronised).
-    fn body(&self, i: usize) -> Body<T, D> {
+    pub(crate) fn ball_body(&self, i: usize) -> Body<T, D> {
         let (m, r) = (self.balls.mass[i], self.balls.radius[i]);
         let inertia = <Const<D> as Space<T, D>>::ball_inertia_factor() * m * r * r;
         Body::new_unchecked(
@@ -129,8 +158,8 @@ where
     }
 
     fn collide_balls(&mut self, i: usize, j: usize, observer: &mut dyn Observer<T>) {
-        self.sync(i);
-        self.sync(j);
+        self.sync_ball(i);
+        self.sync_ball(j);
         let ci = self.balls.pos[i];
         let cj = ci + self.separation(&ci, &self.balls.pos[j]);
         let (ri, rj) = (self.balls.radius[i], self.balls.radius[j]);
@@ -138,7 +167,7 @@ where
             // Coincident centres cannot come from a predicted contact of positive radii.
             return;
         };
-        let (a, b) = (self.body(i), self.body(j));
+        let (a, b) = (self.ball_body(i), self.ball_body(j));
         let approach = -normal_velocity(&a, &b, &contact);
         let nominal = self.ball_restitution(i).min(self.ball_restitution(j));
         let since = [
@@ -157,8 +186,12 @@ where
         }
         self.balls.vel[i] = response.velocity[0];
         self.balls.vel[j] = response.velocity[1];
-        self.balls.spin[i] = response.angular_velocity[0];
-        self.balls.spin[j] = response.angular_velocity[1];
+        // Without friction the impulse is central and cannot spin a ball; keeping the spin
+        // as it is avoids the rounding of r × n (1e-17, not exactly 0).
+        if self.friction > T::zero() {
+            self.balls.spin[i] = response.angular_velocity[0];
+            self.balls.spin[j] = response.angular_velocity[1];
+        }
         self.changed(i);
         self.changed(j);
         self.check_support(i);
@@ -172,13 +205,13 @@ where
     }
 
     /// The ball's restitution in ball–ball collisions: its own or the world's.
-    fn ball_restitution(&self, i: usize) -> T {
+    pub(crate) fn ball_restitution(&self, i: usize) -> T {
         self.balls.restitution[i].unwrap_or(self.world_restitution)
     }
 
     /// The restitution of ball `i` against a surface of restitution `surface`: the
     /// minimum of the ball's own value (if it has one) and the surface's.
-    fn surface_restitution(&self, i: usize, surface: T) -> T {
+    pub(crate) fn surface_restitution(&self, i: usize, surface: T) -> T {
         self.balls.restitution[i].map_or(surface, |e| e.min(surface))
     }
 
@@ -197,7 +230,7 @@ where
         let r = self.balls.radius[i];
         let contact =
             Contact::new_unchecked(normal, normal * r, point - self.balls.pos[i] - normal * r);
-        let a = self.body(i);
+        let a = self.ball_body(i);
         let b = Body::kinematic(surface_velocity, <Const<D> as Space<T, D>>::angular_zero())
             .unwrap_or_else(|_| Body::fixed());
         let approach = -normal_velocity(&a, &b, &contact);
@@ -217,7 +250,9 @@ where
             return false;
         }
         self.balls.vel[i] = response.velocity[0];
-        self.balls.spin[i] = response.angular_velocity[0];
+        if self.friction > T::zero() {
+            self.balls.spin[i] = response.angular_velocity[0];
+        }
         self.changed(i);
         if let (true, Some(s)) = (rest, support) {
             // Rest exactly: no normal velocity relative to the surface, no normal
@@ -233,7 +268,7 @@ where
     }
 
     fn collide_wall(&mut self, i: usize, axis: usize, upper: bool, observer: &mut dyn Observer<T>) {
-        self.sync(i);
+        self.sync_ball(i);
         let Some(border) = self.border else { return };
         let mut normal = Vector::<T, D>::zeros();
         normal[axis] = if upper { T::one() } else { -T::one() };
@@ -261,7 +296,7 @@ where
     }
 
     fn collide_box(&mut self, i: usize, k: usize, observer: &mut dyn Observer<T>) {
-        self.sync(i);
+        self.sync_ball(i);
         let b = self.boxes[k];
         let obb = b.at(self.now);
         let centre = self.balls.pos[i];

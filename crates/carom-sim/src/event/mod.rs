@@ -25,6 +25,7 @@
 //! velocities with their sign flipped.
 
 pub mod calendar;
+mod cluster;
 mod handle;
 pub mod neighbours;
 mod predict;
@@ -40,6 +41,7 @@ use crate::engine::{BallStates, Counters, EngineKind, Observer, SimError, Simula
 use crate::plan::{BroadChoice, Plan};
 use crate::scene::{Inelastic, Scene, SceneError};
 use calendar::Calendar;
+use cluster::ClusterBody;
 use neighbours::{Domain, NeighbourLists};
 use state::{Balls, Mode};
 
@@ -101,6 +103,10 @@ pub(crate) enum Pending {
     Rebuild,
     /// The ball slides off the face it rests on.
     LeaveSupport,
+    /// A contact with stuck cluster `c`, valid while the cluster's count is `count`.
+    Cluster { c: u32, count: u32 },
+    /// Conservative advancement proved no contact only up to this time: predict again.
+    Recheck,
 }
 
 /// The exact event-driven engine. See the [module documentation](self).
@@ -121,6 +127,9 @@ where
     collapse: CollapseGuard<T>,
     resting: RestingGuard<T>,
     balls: Balls<T, D>,
+    clusters: Vec<ClusterBody<T, D>>,
+    /// The size of the scene, for the tolerance of cluster contact searches.
+    length_scale: T,
     partners: Partners<T, D>,
     calendar: Calendar<T>,
     pending: Vec<Pending>,
@@ -160,8 +169,6 @@ where
         }
         let sign = direction.sign::<T>();
         let n = scene.balls.len();
-        let inertia_factor = <Const<D> as Space<T, D>>::ball_inertia_factor();
-        let _ = inertia_factor;
         let balls = Balls {
             pos: scene.balls.iter().map(|b| b.pos).collect(),
             vel: scene.balls.iter().map(|b| b.vel * sign).collect(),
@@ -179,79 +186,14 @@ where
             Some(b) => (Some(b.border), b.restitution, b.periodic),
             None => (None, T::one(), false),
         };
-        let r_min = balls.radius.iter().copied().fold(T::INFINITY, T::min);
-        let r_max = balls.radius.iter().copied().fold(T::zero(), T::max);
-        let r_mean = if n == 0 {
-            T::one()
+        let partners = partners_for(scene, plan, &balls)?;
+        let (collapse, resting) = guards(scene, &balls)?;
+        // Stuck clusters take the calendar slots after the balls (at most n − 1 of them).
+        let slots = if scene.world.inelastic == Inelastic::Stick {
+            2 * n
         } else {
-            balls.radius.iter().copied().fold(T::zero(), |a, b| a + b) / T::from_count(n)
+            n
         };
-        let shell = r_mean * T::lit(SHELL_PER_RADIUS);
-        let use_lists = match plan.broad {
-            BroadChoice::Brute => false,
-            BroadChoice::Grid => true,
-            _ => n > ALL_PAIRS_MAX_BALLS,
-        };
-        let partners = if use_lists && n > 1 {
-            let domain = match (&border, periodic) {
-                (Some(b), true) => Domain::Periodic {
-                    min: b.min(),
-                    max: b.max(),
-                },
-                (Some(b), false) => Domain::Bounded {
-                    min: b.min(),
-                    max: b.max(),
-                },
-                (None, _) => Domain::Unbounded,
-            };
-            Partners::Lists(NeighbourLists::new(
-                &balls.pos,
-                &balls.radius,
-                shell,
-                domain,
-            ))
-        } else {
-            Partners::All
-        };
-        if periodic && let Some(b) = &border {
-            // The minimum image is the only image within reach when every period is longer
-            // than twice the longest reach between two anchors.
-            let reach = (r_max + shell) * T::lit(2.0);
-            if let Some(k) = (0..D).find(|&k| b.extents()[k] <= reach * T::lit(2.0)) {
-                return Err(SceneError::new(
-                    "world.border",
-                    format!(
-                        "a periodic box must be longer than {} on every axis (axis {k} is {})",
-                        reach * T::lit(2.0),
-                        b.extents()[k]
-                    ),
-                ));
-            }
-        }
-        let g = scene.world.gravity.norm();
-        let rms = if n == 0 {
-            T::zero()
-        } else {
-            (balls
-                .vel
-                .iter()
-                .map(|v| v.norm_squared())
-                .fold(T::zero(), |a, b| a + b)
-                / T::from_count(n))
-            .sqrt()
-        };
-        let r_scale = if r_min.finite() { r_min } else { T::one() };
-        let v_scale = rms.max((g * r_scale).sqrt()).max(T::MIN_POSITIVE.sqrt());
-        let collapse =
-            CollapseGuard::tc_model((T::lit(1e-9) * r_scale / v_scale).max(T::MIN_POSITIVE))
-                .map_err(|e| SceneError::new("", format!("collapse guard: {e}")))?;
-        let flight = if g > T::zero() {
-            T::lit(1e-6) * (r_scale / g).sqrt()
-        } else {
-            T::one()
-        };
-        let resting = RestingGuard::new(flight.max(T::MIN_POSITIVE))
-            .map_err(|e| SceneError::new("", format!("resting guard: {e}")))?;
         let boxes: Vec<BoxBody<T, D>> = scene
             .boxes
             .iter()
@@ -273,10 +215,12 @@ where
             friction: scene.world.friction,
             collapse,
             resting,
+            length_scale: length_scale(scene),
             balls,
+            clusters: Vec::new(),
             partners,
-            calendar: Calendar::sized_for(n, T::one(), T::zero()),
-            pending: vec![Pending::None; n],
+            calendar: Calendar::sized_for(slots, T::one(), T::zero()),
+            pending: vec![Pending::None; slots],
             now: T::zero(),
             counters: Counters::default(),
             events_at_instant: 0,
@@ -307,7 +251,8 @@ where
         } else {
             T::one()
         };
-        let mut sized = Calendar::sized_for(n, horizon.max(T::MIN_POSITIVE), self.now);
+        let mut sized =
+            Calendar::sized_for(self.pending.len(), horizon.max(T::MIN_POSITIVE), self.now);
         for i in 0..n {
             sized.schedule(i, self.calendar.time_of(i));
         }
@@ -361,7 +306,7 @@ where
         Ball::new_unchecked(self.balls.position_at(i, t), self.balls.radius[i])
     }
 
-    fn periodic_border(&self) -> Option<&Border<T, D>> {
+    pub(crate) fn periodic_border(&self) -> Option<&Border<T, D>> {
         if self.periodic {
             self.border.as_ref()
         } else {
@@ -380,6 +325,16 @@ where
 
     /// The state of ball `i` now, in reported (signed) terms.
     fn reported_state(&self, i: usize) -> (Vector<T, D>, Vector<T, D>) {
+        if let Mode::Stuck(c) = self.balls.mode[i] {
+            let body = &self.clusters[c];
+            let k = body
+                .members
+                .iter()
+                .position(|&m| m as usize == i)
+                .expect("a stuck ball is a member");
+            let (p, v) = body.member_state(k, self.now);
+            return (p, v.map(|x| x * self.sign + T::zero()));
+        }
         let p = self.balls.position_at(i, self.now);
         let p = match self.periodic_border() {
             Some(b) => b.wrap(&p),
@@ -459,12 +414,126 @@ where
             let (p, v) = self.reported_state(i);
             out.pos.push(p);
             out.vel.push(v);
+            let spin = match self.balls.mode[i] {
+                Mode::Stuck(c) => self.clusters[c].rigid.angular_velocity(),
+                _ => self.balls.spin[i],
+            };
             out.spin
-                .push(self.balls.spin[i] * self.sign + <Const<D> as Space<T, D>>::angular_zero());
+                .push(spin * self.sign + <Const<D> as Space<T, D>>::angular_zero());
         }
     }
 
     fn counters(&self) -> Counters {
         self.counters
     }
+}
+
+/// The size of a scene: the largest border extent, or the spread of the balls.
+fn length_scale<T: Real, const D: usize>(scene: &Scene<T, D>) -> T {
+    let spread = scene
+        .balls
+        .iter()
+        .map(|b| b.pos.amax() + b.radius)
+        .fold(T::zero(), T::max);
+    let border = scene
+        .world
+        .border
+        .map_or(T::zero(), |b| b.border.extents().amax());
+    spread.max(border).max(T::MIN_POSITIVE.sqrt())
+}
+
+/// Neighbour lists for more than a handful of balls (or when asked), every pair
+/// otherwise; checks that a periodic box is large enough for the minimum image.
+fn partners_for<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    plan: &Plan,
+    balls: &Balls<T, D>,
+) -> Result<Partners<T, D>, SceneError>
+where
+    Const<D>: Space<T, D>,
+{
+    let n = balls.len();
+    let r_max = balls.radius.iter().copied().fold(T::zero(), T::max);
+    let r_mean = if n == 0 {
+        T::one()
+    } else {
+        balls.radius.iter().copied().fold(T::zero(), |a, b| a + b) / T::from_count(n)
+    };
+    let shell = r_mean * T::lit(SHELL_PER_RADIUS);
+    if let Some(b) = scene.world.border.filter(|b| b.periodic).map(|b| b.border) {
+        // The minimum image is the only image within reach when every period is longer
+        // than twice the longest reach between two anchors.
+        let reach = (r_max + shell) * T::lit(2.0);
+        if let Some(k) = (0..D).find(|&k| b.extents()[k] <= reach * T::lit(2.0)) {
+            return Err(SceneError::new(
+                "world.border",
+                format!(
+                    "a periodic box must be longer than {} on every axis (axis {k} is {})",
+                    reach * T::lit(2.0),
+                    b.extents()[k]
+                ),
+            ));
+        }
+    }
+    let use_lists = match plan.broad {
+        BroadChoice::Brute => false,
+        BroadChoice::Grid => true,
+        _ => n > ALL_PAIRS_MAX_BALLS,
+    };
+    if !use_lists || n < 2 {
+        return Ok(Partners::All);
+    }
+    let domain = match &scene.world.border {
+        Some(b) if b.periodic => Domain::Periodic {
+            min: b.border.min(),
+            max: b.border.max(),
+        },
+        Some(b) => Domain::Bounded {
+            min: b.border.min(),
+            max: b.border.max(),
+        },
+        None => Domain::Unbounded,
+    };
+    Ok(Partners::Lists(NeighbourLists::new(
+        &balls.pos,
+        &balls.radius,
+        shell,
+        domain,
+    )))
+}
+
+/// The collapse and resting guards with scales from the scene (see [`EventEngine::new`]).
+fn guards<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    balls: &Balls<T, D>,
+) -> Result<(CollapseGuard<T>, RestingGuard<T>), SceneError>
+where
+    Const<D>: Space<T, D>,
+{
+    let n = balls.len();
+    let g = scene.world.gravity.norm();
+    let r_min = balls.radius.iter().copied().fold(T::INFINITY, T::min);
+    let r_scale = if r_min.finite() { r_min } else { T::one() };
+    let rms = if n == 0 {
+        T::zero()
+    } else {
+        (balls
+            .vel
+            .iter()
+            .map(Vector::norm_squared)
+            .fold(T::zero(), |a, b| a + b)
+            / T::from_count(n))
+        .sqrt()
+    };
+    let v_scale = rms.max((g * r_scale).sqrt()).max(T::MIN_POSITIVE.sqrt());
+    let collapse = CollapseGuard::tc_model((T::lit(1e-9) * r_scale / v_scale).max(T::MIN_POSITIVE))
+        .map_err(|e| SceneError::new("", format!("collapse guard: {e}")))?;
+    let flight = if g > T::zero() {
+        T::lit(1e-6) * (r_scale / g).sqrt()
+    } else {
+        T::one()
+    };
+    let resting = RestingGuard::new(flight.max(T::MIN_POSITIVE))
+        .map_err(|e| SceneError::new("", format!("resting guard: {e}")))?;
+    Ok((collapse, resting))
 }

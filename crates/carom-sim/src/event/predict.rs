@@ -5,6 +5,7 @@
 //! collision with each partner. Each search is given the best time found so far as its
 //! horizon, so later candidates stop early.
 
+use carom_geometry::Ball;
 use carom_math::{Real, Space, Vector};
 use carom_toi::{Kinematics, Window, ball_ball, ball_border, ball_obb, level_crossing};
 use nalgebra::Const;
@@ -23,111 +24,125 @@ where
     /// Predicts and schedules ball `i`'s next event (balls in clusters are scheduled by
     /// their cluster).
     pub(crate) fn predict(&mut self, i: usize) {
-        let now = self.now;
-        let mut best_t = T::INFINITY;
-        let mut best = Pending::None;
         if let Mode::Stuck(_) = self.balls.mode[i] {
             self.pending[i] = Pending::None;
             self.calendar.cancel(i);
             return;
         }
+        let mut best = self.own_event(i);
+        let ball = self.ball_at(i, self.now);
+        let kin =
+            Kinematics::new_unchecked(self.balls.velocity_at(i, self.now), self.balls.accel[i]);
+        self.offer_surfaces(&ball, &kin, &mut best);
+        if !self.clusters.is_empty() {
+            self.predict_ball_vs_clusters(i, &mut best.time, &mut best.pending);
+        }
+        self.offer_partners(i, &ball, &kin, &mut best);
+        self.pending[i] = best.pending;
+        self.calendar.schedule(i, best.time);
+    }
+
+    /// The events of ball `i` alone: leaving its neighbour-list shell, sliding off the
+    /// face it rests on.
+    fn own_event(&self, i: usize) -> Best<T> {
+        let now = self.now;
+        let mut best = Best {
+            time: T::INFINITY,
+            pending: Pending::None,
+        };
         if let Partners::Lists(lists) = &self.partners {
             let displacement = self.separation(lists.anchor(i), &self.balls.position_at(i, now));
+            let velocity = self.balls.velocity_at(i, now);
             let s = exit_time(
                 &displacement,
-                &self.balls.velocity_at(i, now),
+                &velocity,
                 &self.balls.accel[i],
                 lists.shell() * T::lit(SHELL_SAFETY),
             );
-            best_t = now + s;
-            best = Pending::Rebuild;
+            best.offer(now + s, Pending::Rebuild);
         }
         if let Mode::Resting(Support::BoxFace { k, axis, .. }) = self.balls.mode[i]
             && let Some(s) = self.face_exit_time(i, k, axis)
-            && now + s < best_t
         {
-            best_t = now + s;
-            best = Pending::LeaveSupport;
+            best.offer(now + s, Pending::LeaveSupport);
         }
-        let ball = self.ball_at(i, now);
-        let kin = Kinematics::new_unchecked(self.balls.velocity_at(i, now), self.balls.accel[i]);
-        let window = |best_t: T| {
-            Window::forward(best_t - now)
-                .unwrap_or_else(|_| Window::forward(T::zero()).expect("0 is a valid horizon"))
-        };
+        best
+    }
+
+    /// The first contact of a ball with a border wall or a box.
+    fn offer_surfaces(&self, ball: &Ball<T, D>, kin: &Kinematics<T, D>, best: &mut Best<T>) {
+        let now = self.now;
         if let (Some(border), false) = (&self.border, self.periodic) {
-            let toi = ball_border(&ball, &kin, border, &window(best_t));
-            if let Some(s) = toi.hit_time()
-                && now + s < best_t
-            {
-                best_t = now + s;
-                best = Pending::Wall {
-                    axis: toi.feature.axis as u8,
-                    upper: toi.feature.side == carom_toi::Side::Upper,
-                };
+            let toi = ball_border(ball, kin, border, &best.window(now));
+            if let Some(s) = toi.hit_time() {
+                let upper = toi.feature.side == carom_toi::Side::Upper;
+                best.offer(
+                    now + s,
+                    Pending::Wall {
+                        axis: toi.feature.axis as u8,
+                        upper,
+                    },
+                );
             }
         }
         for (k, b) in self.boxes.iter().enumerate() {
             let obb = b.at(now);
             // In a periodic box, the image of the ball nearest the box.
             let image = if self.periodic {
-                carom_geometry::Ball::new_unchecked(
+                Ball::new_unchecked(
                     obb.center() - self.separation(&ball.center(), &obb.center()),
                     ball.radius(),
                 )
             } else {
-                ball
+                *ball
             };
             let toi = ball_obb(
                 &image,
-                &kin,
+                kin,
                 &obb,
                 &Kinematics::new_unchecked(b.vel, Vector::zeros()),
-                &window(best_t),
+                &best.window(now),
             );
-            if let Some(s) = toi.hit_time()
-                && now + s < best_t
-            {
-                best_t = now + s;
-                best = Pending::Box { k: k as u32 };
+            if let Some(s) = toi.hit_time() {
+                best.offer(now + s, Pending::Box { k: k as u32 });
             }
         }
-        let consider = |j: usize, best_t: &mut T, best: &mut Pending| {
+    }
+
+    /// The first collision of ball `i` with each of its partners.
+    fn offer_partners(
+        &self,
+        i: usize,
+        ball: &Ball<T, D>,
+        kin: &Kinematics<T, D>,
+        best: &mut Best<T>,
+    ) {
+        let now = self.now;
+        let mut consider = |j: usize| {
             if j == i || matches!(self.balls.mode[j], Mode::Stuck(_)) {
                 return;
             }
             let pj = self.balls.position_at(j, now);
-            let other = carom_geometry::Ball::new_unchecked(
+            let other = Ball::new_unchecked(
                 ball.center() + self.separation(&ball.center(), &pj),
                 self.balls.radius[j],
             );
             let kin_j =
                 Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel[j]);
-            let toi = ball_ball(&ball, &kin, &other, &kin_j, &window(*best_t));
-            if let Some(s) = toi.hit_time()
-                && now + s < *best_t
-            {
-                *best_t = now + s;
-                *best = Pending::Ball {
-                    j: j as u32,
-                    count: self.balls.count[j],
-                };
+            if let Some(s) = ball_ball(ball, kin, &other, &kin_j, &best.window(now)).hit_time() {
+                best.offer(
+                    now + s,
+                    Pending::Ball {
+                        j: j as u32,
+                        count: self.balls.count[j],
+                    },
+                );
             }
         };
         match &self.partners {
-            Partners::All => {
-                for j in 0..self.balls.len() {
-                    consider(j, &mut best_t, &mut best);
-                }
-            }
-            Partners::Lists(lists) => {
-                for &j in lists.partners(i) {
-                    consider(j as usize, &mut best_t, &mut best);
-                }
-            }
+            Partners::All => (0..self.balls.len()).for_each(&mut consider),
+            Partners::Lists(lists) => lists.partners(i).iter().for_each(|&j| consider(j as usize)),
         }
-        self.pending[i] = best;
-        self.calendar.schedule(i, best_t);
     }
 
     /// When the centre of resting ball `i` leaves the face (axis `axis`) of box `k` it
@@ -155,6 +170,30 @@ where
             }
         }
         first
+    }
+}
+
+/// The earliest candidate event so far; later searches use its time as their horizon.
+struct Best<T: Real> {
+    time: T,
+    pending: Pending,
+}
+
+impl<T: Real> Best<T> {
+    /// Keeps `pending` at `time` if it is earlier (ties keep the first offered).
+    #[inline]
+    fn offer(&mut self, time: T, pending: Pending) {
+        if time < self.time {
+            self.time = time;
+            self.pending = pending;
+        }
+    }
+
+    /// A forward window from `now` to the best time so far.
+    #[inline]
+    fn window(&self, now: T) -> Window<T> {
+        Window::forward(self.time - now)
+            .unwrap_or_else(|_| Window::forward(T::zero()).expect("0 is a valid horizon"))
     }
 }
 
