@@ -54,9 +54,14 @@ impl<T: Real, const D: usize> BoundingVolume<T, D> for Aabb<T, D> {
         (0..D).all(|i| self.min()[i] <= other.min()[i] && other.max()[i] <= self.max()[i])
     }
 
+    /// Branch-free over the axes (`&`, not `&&`): a broad phase sees overlapping and
+    /// separate pairs in no predictable order, and mispredicted early exits cost more
+    /// than the few comparisons they save.
     #[inline]
     fn intersects(&self, other: &Self) -> bool {
-        (0..D).all(|i| self.min()[i] <= other.max()[i] && other.min()[i] <= self.max()[i])
+        (0..D).fold(true, |all, i| {
+            all & (self.min()[i] <= other.max()[i]) & (other.min()[i] <= self.max()[i])
+        })
     }
 
     #[inline]

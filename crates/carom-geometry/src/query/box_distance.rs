@@ -94,20 +94,23 @@ impl<T: Real, const D: usize> RelativeBoxes<T, D> {
         let t_u = self.t.dot(&u);
         let a_top = self.ha.dot(&u.abs());
         let b_bottom = t_u - self.hb.dot(&u_in_b.abs());
-        // Heights on u of every corner of A and of B (at most 8 each).
+        // Every corner of A and of B (in A's frame) and its height on u (at most 8 each).
+        let mut a_corner = [Vector::<T, D>::zeros(); 8];
+        let mut b_corner = [Vector::<T, D>::zeros(); 8];
         let mut a_height = [T::zero(); 8];
         let mut b_height = [T::zero(); 8];
         for k in 0..corners {
-            a_height[k] = corner(&self.ha, k).dot(&u);
-            b_height[k] = t_u + corner(&self.hb, k).dot(&u_in_b);
+            a_corner[k] = corner(&self.ha, k);
+            let b_local = corner(&self.hb, k);
+            b_corner[k] = self.t + self.r * b_local;
+            a_height[k] = a_corner[k].dot(&u);
+            b_height[k] = t_u + b_local.dot(&u_in_b);
         }
-        let b_world = |local: Vector<T, D>| self.t + self.r * local;
         let a_corner_to_b = |k: usize| {
-            let a_in_b = self.r.tr_mul(&(corner(&self.ha, k) - self.t));
+            let a_in_b = self.r.tr_mul(&(a_corner[k] - self.t));
             point_box_distance_squared(&a_in_b, &self.hb)
         };
-        let b_corner_to_a =
-            |m: usize| point_box_distance_squared(&b_world(corner(&self.hb, m)), &self.ha);
+        let b_corner_to_a = |m: usize| point_box_distance_squared(&b_corner[m], &self.ha);
         let highest = (0..corners).fold(0, |best, k| {
             if a_height[k] > a_height[best] {
                 k
@@ -142,16 +145,18 @@ impl<T: Real, const D: usize> RelativeBoxes<T, D> {
                     if beaten(b_bottom - a_high, best) {
                         continue;
                     }
-                    let (p1, q1) = (corner(&self.ha, k), corner(&self.ha, k2));
                     for j in 0..D {
                         for m in (0..corners).filter(|m| m >> j & 1 == 0) {
                             let m2 = m | 1 << j;
                             if beaten(b_height[m].min(b_height[m2]) - a_high, best) {
                                 continue;
                             }
-                            let p2 = b_world(corner(&self.hb, m));
-                            let q2 = b_world(corner(&self.hb, m2));
-                            best = best.min(segment_segment_distance_squared(&p1, &q1, &p2, &q2));
+                            best = best.min(segment_segment_distance_squared(
+                                &a_corner[k],
+                                &a_corner[k2],
+                                &b_corner[m],
+                                &b_corner[m2],
+                            ));
                         }
                     }
                 }

@@ -210,7 +210,8 @@ impl<T: Real, const D: usize> RayCast<T, D> for Ball<T, D> {
             return start_inside(self, &ray.origin, max_toi);
         }
         // A direction whose squared length underflows or overflows is cast as a unit
-        // direction, and the time scaled back by its length.
+        // direction, and the time scaled back by its length (a zero direction becomes
+        // `+x` at speed 0: its infinite time is rejected below).
         let (d, speed) = {
             let a = ray.direction.norm_squared();
             if a >= T::MIN_POSITIVE && a <= T::MAX {
@@ -221,7 +222,7 @@ impl<T: Real, const D: usize> RayCast<T, D> for Ball<T, D> {
         };
         let b = oc.dot(&d);
         if b >= T::zero() {
-            return None; // moving away (or not moving: b = 0 for d = 0)
+            return None; // moving away
         }
         let a = d.norm_squared();
         let l = oc - d * (b / a);
@@ -327,6 +328,16 @@ mod tests {
         let hit = b.cast_ray(&ray2((0.0, 0.0), (0.0, 1.0)), 10.0).unwrap();
         assert_eq!(hit.normal, Vector2::x());
         assert!(b.cast_ray(&ray2((0.0, 0.5), (1.0, 0.0)), -1.0).is_none());
+        // A zero direction from outside never arrives; a tiny one arrives very late.
+        assert!(
+            b.cast_ray(&ray2((-5.0, 0.0), (0.0, 0.0)), f64::INFINITY)
+                .is_none()
+        );
+        let hit = b
+            .cast_ray(&ray2((-5.0, 0.0), (1e-200, 0.0)), f64::INFINITY)
+            .unwrap();
+        assert_relative_eq!(hit.toi, 4e200, max_relative = 1e-15);
+        assert_eq!(hit.normal, -Vector2::x());
     }
 
     #[test]

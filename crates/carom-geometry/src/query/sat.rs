@@ -2,6 +2,8 @@
 //! the best separating axis. The method and its treatment of parallel edges are
 //! documented on [`separation`].
 
+use core::ops::ControlFlow;
+
 use carom_math::{Real, Rotation, Space, Vector};
 use nalgebra::{Const, SMatrix};
 
@@ -80,27 +82,30 @@ impl<T: Real, const D: usize> RelativeBoxes<T, D> {
         (ra, rb)
     }
 
-    /// `true` if the boxes overlap or touch (or are closer than `16 ulp · Σ h` across
-    /// near-parallel edges; see the module notes).
-    pub(crate) fn overlap(&self) -> bool
+    /// Visits every candidate axis `l` (in A's frame) with `t · l` and the sum of the
+    /// projected radii `r_A + r_B` (each `|·|` term grown by `slack`), until `visit`
+    /// breaks: A's face axes, B's face axes (`unit` is `true` for these), then the edge
+    /// crosses from [`Space::edge_axes`] (not normalised, `unit` is `false`).
+    fn visit_axes(
+        &self,
+        slack: T,
+        mut visit: impl FnMut(&Vector<T, D>, bool, T, T) -> ControlFlow<()>,
+    ) -> ControlFlow<()>
     where
         Const<D>: Space<T, D>,
     {
-        let slack = T::lit(OVERLAP_SLACK_ULPS) * T::EPSILON;
         let abs_r = self.r.abs().add_scalar(slack);
         // A's face axes: L = e_i, r_A = hA_i, r_B = Σ_k hB_k |R_ik|.
         for i in 0..D {
-            let rb = abs_r.row(i).transpose().dot(&self.hb);
-            if self.t[i].abs() > self.ha[i] + rb {
-                return false;
-            }
+            let l = Vector::<T, D>::from_fn(|k, _| if k == i { T::one() } else { T::zero() });
+            let reach = self.ha[i] + abs_r.row(i).transpose().dot(&self.hb);
+            visit(&l, true, self.t[i], reach)?;
         }
         // B's face axes: L = R e_j, r_A = Σ_k hA_k |R_kj|, r_B = hB_j.
         for j in 0..D {
-            let ra = abs_r.column(j).dot(&self.ha);
-            if self.r.column(j).dot(&self.t).abs() > ra + self.hb[j] {
-                return false;
-            }
+            let l = self.r.column(j).into_owned();
+            let reach = abs_r.column(j).dot(&self.ha) + self.hb[j];
+            visit(&l, true, l.dot(&self.t), reach)?;
         }
         let mut axes = [Vector::<T, D>::zeros(); 9];
         let n = <Const<D> as Space<T, D>>::edge_axes(
@@ -110,51 +115,48 @@ impl<T: Real, const D: usize> RelativeBoxes<T, D> {
         );
         for l in &axes[..n] {
             let (ra, rb) = self.projected_radii(l, slack);
-            if self.t.dot(l).abs() > ra + rb {
-                return false;
-            }
+            visit(l, false, self.t.dot(l), ra + rb)?;
         }
-        true
+        ControlFlow::Continue(())
+    }
+
+    /// `true` if the boxes overlap or touch (or are closer than `16 ulp · Σ h` across
+    /// near-parallel edges; see [`separation`]). Stops at the first separating axis.
+    pub(crate) fn overlap(&self) -> bool
+    where
+        Const<D>: Space<T, D>,
+    {
+        let slack = T::lit(OVERLAP_SLACK_ULPS) * T::EPSILON;
+        self.visit_axes(slack, |_, _, along, reach| {
+            if along.abs() > reach {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .is_continue()
     }
 
     /// The axis (in A's frame, unit, from B towards A) of largest signed gap, and the gap.
+    /// Edge axes shorter than `√ε` are skipped; the others are normalised only when they
+    /// beat the best so far.
     pub(crate) fn separation(&self) -> (Vector<T, D>, T)
     where
         Const<D>: Space<T, D>,
     {
-        let mut best = (first_axis(), -T::INFINITY);
-        let mut consider = |l: Vector<T, D>, gap: T| {
-            if gap > best.1 {
-                let along = self.t.dot(&l);
-                best = (if along > T::zero() { -l } else { l }, gap);
-            }
-        };
-        for i in 0..D {
-            let l = Vector::<T, D>::from_fn(|k, _| if k == i { T::one() } else { T::zero() });
-            let (ra, rb) = self.projected_radii(&l, T::zero());
-            consider(l, self.t[i].abs() - ra - rb);
-        }
-        for j in 0..D {
-            let l = self.r.column(j).into_owned();
-            let (ra, rb) = self.projected_radii(&l, T::zero());
-            consider(l, self.t.dot(&l).abs() - ra - rb);
-        }
-        let mut axes = [Vector::<T, D>::zeros(); 9];
-        let n = <Const<D> as Space<T, D>>::edge_axes(
-            &Rotation::identity(),
-            &Rotation::from_matrix_unchecked(self.r),
-            &mut axes,
-        );
         let min_len = T::EPSILON.sqrt();
-        for raw in &axes[..n] {
-            let len = raw.norm();
-            if len < min_len {
-                continue;
+        let mut best = (first_axis(), -T::INFINITY);
+        let _ = self.visit_axes(T::zero(), |l, unit, along, reach| {
+            let len = if unit { T::one() } else { l.norm() };
+            if len >= min_len {
+                let gap = (along.abs() - reach) / len;
+                if gap > best.1 {
+                    let l = if unit { *l } else { l / len };
+                    best = (if along > T::zero() { -l } else { l }, gap);
+                }
             }
-            let l = raw / len;
-            let (ra, rb) = self.projected_radii(&l, T::zero());
-            consider(l, self.t.dot(&l).abs() - ra - rb);
-        }
+            ControlFlow::Continue(())
+        });
         best
     }
 }
