@@ -19,12 +19,24 @@ use carom::sim::{EngineKind, EventEngine, Simulation};
 use carom::toi::Direction;
 
 fn plan() -> Plan {
-    Plan { engine: EngineKind::Event, reason: "bench", integrator: None, dt: None, broad: BroadChoice::Auto }
+    Plan {
+        engine: EngineKind::Event,
+        reason: "bench",
+        integrator: None,
+        dt: None,
+        broad: BroadChoice::Auto,
+    }
 }
 
 macro_rules! gas_bench {
     ($c:expr, $name:literal, $dim:literal, $n:expr, $phi:expr) => {{
-        let p = GasParams { n: $n, fraction: $phi, periodic: true, seed: 7, ..GasParams::default() };
+        let p = GasParams {
+            n: $n,
+            fraction: $phi,
+            periodic: true,
+            seed: 7,
+            ..GasParams::default()
+        };
         let scene = gas::<$dim>(&p).expect("a valid gas");
         let mut sim = EventEngine::new(&scene, &plan(), Direction::Forward).expect("runs");
         sim.advance_to(2.0, &mut ()).expect("relaxes");
@@ -40,7 +52,9 @@ macro_rules! gas_bench {
         t = sim.time();
         let mut group = $c.benchmark_group($name);
         group.throughput(Throughput::Elements(per_span));
-        group.sample_size(10).measurement_time(Duration::from_secs(20));
+        group
+            .sample_size(10)
+            .measurement_time(Duration::from_secs(20));
         group.bench_function(BenchmarkId::from_parameter($n), |b| {
             b.iter(|| {
                 t += span;
@@ -53,7 +67,11 @@ macro_rules! gas_bench {
 
 fn event_engine(c: &mut Criterion) {
     let quick = std::env::var_os("CAROM_BENCH_QUICK").is_some();
-    let (n3, n2) = if quick { (4_000, 10_000) } else { (32_000, 100_000) };
+    let (n3, n2) = if quick {
+        (4_000, 10_000)
+    } else {
+        (32_000, 100_000)
+    };
     gas_bench!(c, "event/3d-hard-spheres-phi0.45", 3, n3, 0.45);
     gas_bench!(c, "event/2d-discs-phi0.3", 2, n2, 0.3);
 }

@@ -49,10 +49,12 @@ use state::{Balls, Mode};
 /// (when `--broad auto`).
 pub const ALL_PAIRS_MAX_BALLS: usize = 32;
 
-/// The neighbour-list shell as a fraction of the mean ball radius: a ball rebuilds its
-/// list after moving half a radius (lists then reach 1.5 diameters between anchors,
-/// Smallenburg's choice for dense hard spheres).
-pub const SHELL_PER_RADIUS: f64 = 0.5;
+/// How many partners a neighbour list should hold on average. The shell that gives it
+/// follows from the density: dense gases get thin shells (lists of the nearest balls,
+/// rebuilt often), dilute ones thick shells (a ball flies far between rebuilds).
+pub const LIST_PARTNERS_2D: f64 = 10.0;
+/// As [`LIST_PARTNERS_2D`], in 3D.
+pub const LIST_PARTNERS_3D: f64 = 16.0;
 
 /// Consecutive events at one instant allowed per ball before the run is declared stuck
 /// (a Newton's cradle of `n` balls takes `n` events at one instant).
@@ -454,12 +456,7 @@ where
 {
     let n = balls.len();
     let r_max = balls.radius.iter().copied().fold(T::zero(), T::max);
-    let r_mean = if n == 0 {
-        T::one()
-    } else {
-        balls.radius.iter().copied().fold(T::zero(), |a, b| a + b) / T::from_count(n)
-    };
-    let shell = r_mean * T::lit(SHELL_PER_RADIUS);
+    let shell = list_shell(scene, balls);
     if let Some(b) = scene.world.border.filter(|b| b.periodic).map(|b| b.border) {
         // The minimum image is the only image within reach when every period is longer
         // than twice the longest reach between two anchors.
@@ -500,6 +497,47 @@ where
         shell,
         domain,
     )))
+}
+
+/// The shell `δ` whose lists hold about [`LIST_PARTNERS_2D`] (3D: [`LIST_PARTNERS_3D`])
+/// partners: anchors within `R = 2r̄ + 2δ` of a ball number `ρ c_D R^D` at number density
+/// `ρ` (`c_D` the unit ball's content), so `R = (K / (ρ c_D))^(1/D)`. The density is taken
+/// over the border, or the box spanned by the balls. `δ` is kept within `[r̄/4, 8 r̄]`.
+fn list_shell<T: Real, const D: usize>(scene: &Scene<T, D>, balls: &Balls<T, D>) -> T
+where
+    Const<D>: Space<T, D>,
+{
+    let n = balls.len().max(1);
+    let r_mean = balls.radius.iter().copied().fold(T::zero(), |a, b| a + b) / T::from_count(n);
+    let r_max = balls.radius.iter().copied().fold(T::zero(), T::max);
+    let volume = match &scene.world.border {
+        Some(b) => b.border.extents().product(),
+        None => {
+            let (mut lo, mut hi) = (
+                Vector::<T, D>::repeat(T::INFINITY),
+                Vector::<T, D>::repeat(-T::INFINITY),
+            );
+            for p in &balls.pos {
+                lo = lo.inf(p);
+                hi = hi.sup(p);
+            }
+            (hi - lo).add_scalar(T::lit(2.0) * r_max).product()
+        }
+    };
+    let (partners, unit) = if D == 2 {
+        (T::lit(LIST_PARTNERS_2D), T::pi())
+    } else {
+        (T::lit(LIST_PARTNERS_3D), T::lit(4.0 / 3.0) * T::pi())
+    };
+    let density = T::from_count(n) / volume;
+    let reach = (partners / (density * unit)).powf(T::one() / T::from_count(D));
+    let shell = (reach - T::lit(2.0) * r_mean) * T::lit(0.5);
+    let shell = shell.max(r_mean * T::lit(0.25)).min(r_mean * T::lit(8.0));
+    if shell.finite() {
+        shell
+    } else {
+        r_mean * T::lit(0.5)
+    }
 }
 
 /// The collapse and resting guards with scales from the scene (see [`EventEngine::new`]).

@@ -260,14 +260,24 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
                 let mut index = 0i64;
                 for k in (0..D).rev() {
                     let mut ck = c[k];
+                    let n = counts[k];
+                    // Neighbour offsets are within one cell of the grid, so a wrap or a
+                    // clamp is one comparison (no integer division).
                     if *periodic {
-                        ck = ck.rem_euclid(counts[k]);
-                    } else if ck < -1 || ck > counts[k] {
+                        if ck < 0 {
+                            ck += n;
+                        } else if ck >= n {
+                            ck -= n;
+                        }
+                        if !(0..n).contains(&ck) {
+                            ck = ck.rem_euclid(n);
+                        }
+                    } else if ck < -1 || ck > n {
                         return None;
                     } else {
                         // The edge cells extend to infinity: a point just outside
                         // (rounding) or a neighbour offset past the edge lands there.
-                        ck = ck.clamp(0, counts[k] - 1);
+                        ck = ck.clamp(0, n - 1);
                     }
                     index = index * counts[k] + ck;
                 }

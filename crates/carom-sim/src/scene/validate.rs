@@ -95,20 +95,26 @@ impl<T: Real, const D: usize> Scene<T, D> {
             restitution(b.restitution).map_err(at("world.border"))?;
         }
         for (i, b) in self.balls.iter().enumerate() {
-            let ctx = format!("balls[{i}]");
-            let ball = at(&ctx);
-            ensure_finite_vector("pos", &b.pos).map_err(&ball)?;
-            ensure_finite_vector("vel", &b.vel).map_err(&ball)?;
-            ensure_positive("radius", b.radius).map_err(&ball)?;
-            ensure_positive("mass", b.mass).map_err(&ball)?;
-            if let Some(e) = b.restitution {
-                restitution(e).map_err(&ball)?;
-            }
+            // The entry's name is formatted only for an error.
+            let check = || -> Result<(), InvalidValue> {
+                ensure_finite_vector("pos", &b.pos)?;
+                ensure_finite_vector("vel", &b.vel)?;
+                ensure_positive("radius", b.radius)?;
+                ensure_positive("mass", b.mass)?;
+                if let Some(e) = b.restitution {
+                    restitution(e)?;
+                }
+                Ok(())
+            };
+            check().map_err(|e| SceneError::from(e.within(&format!("balls[{i}]"))))?;
         }
         for (i, b) in self.boxes.iter().enumerate() {
-            let ctx = format!("boxes[{i}]");
-            ensure_finite_vector("vel", &b.vel).map_err(at(&ctx))?;
-            restitution(b.restitution).map_err(at(&ctx))?;
+            let check = || -> Result<(), InvalidValue> {
+                ensure_finite_vector("vel", &b.vel)?;
+                restitution(b.restitution)?;
+                Ok(())
+            };
+            check().map_err(|e| SceneError::from(e.within(&format!("boxes[{i}]"))))?;
         }
         Ok(())
     }
