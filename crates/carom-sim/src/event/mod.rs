@@ -510,9 +510,8 @@ where
     let n = balls.len().max(1);
     let r_mean = balls.radius.iter().copied().fold(T::zero(), |a, b| a + b) / T::from_count(n);
     let r_max = balls.radius.iter().copied().fold(T::zero(), T::max);
-    let volume = match &scene.world.border {
-        Some(b) => b.border.extents().product(),
-        None => {
+    let volume = scene.world.border.map_or_else(
+        || {
             let (mut lo, mut hi) = (
                 Vector::<T, D>::repeat(T::INFINITY),
                 Vector::<T, D>::repeat(-T::INFINITY),
@@ -522,8 +521,9 @@ where
                 hi = hi.sup(p);
             }
             (hi - lo).add_scalar(T::lit(2.0) * r_max).product()
-        }
-    };
+        },
+        |b| b.border.extents().product(),
+    );
     let (partners, unit) = if D == 2 {
         (T::lit(LIST_PARTNERS_2D), T::pi())
     } else {
