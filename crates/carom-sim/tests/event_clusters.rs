@@ -206,3 +206,23 @@ fn slide_instead_of_stick_keeps_the_balls_apart() {
         "frictionless sliding does not spin the balls"
     );
 }
+
+#[test]
+fn a_cluster_landing_flat_on_a_wall_bounces_straight_back_without_spin() {
+    // Criss-cross sticks into a horizontal pair moving up at 0.5 m/s: both balls reach the
+    // top wall at the same instant. The reaction acts below the centre of mass: no spin.
+    let s = stick(InelasticPreset::CrissCross, true);
+    let mut sim = EventEngine::new(&s, &plan(), Direction::Forward).unwrap();
+    let mut log = Log::default();
+    sim.advance_to(2.5, &mut log).unwrap();
+    let st = states(&sim);
+    assert!(
+        log.0
+            .iter()
+            .any(|c| matches!(c, Collision::BallBorder { .. }))
+    );
+    assert!(st.spin[0].x.abs() < 1e-12, "spin {}", st.spin[0].x);
+    for v in &st.vel {
+        assert!((v - Vector2::new(0.0, -0.5)).norm() < 1e-12, "{v:?}");
+    }
+}

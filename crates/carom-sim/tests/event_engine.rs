@@ -572,3 +572,71 @@ fn three_dimensional_scenes_with_walls_and_boxes_run() {
         );
     }
 }
+
+#[test]
+fn every_collision_lab_screen_runs_and_keeps_what_the_sim_teaches() {
+    use carom_sim::scene::Inelastic;
+    use carom_sim::scenes::collision_lab::{InelasticPreset, Options, Screen, scene};
+    let screens = [
+        Screen::Intro,
+        Screen::Explore1d,
+        Screen::Explore2d,
+        Screen::Inelastic(InelasticPreset::HeadOn),
+        Screen::Inelastic(InelasticPreset::CrissCross),
+        Screen::Inelastic(InelasticPreset::Glancing),
+    ];
+    for screen in screens {
+        for elasticity in [None, Some(100.0), Some(50.0), Some(0.0)] {
+            for inelastic in [Inelastic::Slide, Inelastic::Stick] {
+                for reflecting_border in [true, false] {
+                    let opts = Options {
+                        elasticity_percent: elasticity,
+                        reflecting_border,
+                        inelastic,
+                        ..Options::default()
+                    };
+                    let s = scene(screen, &opts);
+                    let mut sim =
+                        EventEngine::new(&s, &plan(BroadChoice::Auto), Direction::Forward).unwrap();
+                    let mut st = BallStates::default();
+                    sim.states(&mut st);
+                    let (e0, p0) = (energy(&s, &st), momentum(&s, &st));
+                    let mut log = Log::default();
+                    sim.advance_to(10.0, &mut log).unwrap();
+                    sim.states(&mut st);
+                    let (e1, p1) = (energy(&s, &st), momentum(&s, &st));
+                    let what = format!("{screen:?} {opts:?}");
+                    assert!(e1 <= e0 * (1.0 + 1e-12), "{what}: energy grew {e0} → {e1}");
+                    if s.world.restitution == 1.0 {
+                        assert!(
+                            (e1 - e0).abs() <= 1e-12 * e0,
+                            "{what}: elastic energy {e0} → {e1}"
+                        );
+                    }
+                    let walls = log
+                        .0
+                        .iter()
+                        .any(|c| matches!(c, Collision::BallBorder { .. }));
+                    if !walls {
+                        assert!(
+                            (p1 - p0).norm() <= 1e-12 * (1.0 + p0.norm()),
+                            "{what}: momentum {p0:?} → {p1:?}"
+                        );
+                    }
+                    if reflecting_border {
+                        let b = s.world.border.unwrap().border;
+                        for (k, p) in st.pos.iter().enumerate() {
+                            let r = s.balls[k].radius;
+                            assert!(
+                                (0..2).all(|a| p[a] - r >= b.min()[a] - 1e-9
+                                    && p[a] + r <= b.max()[a] + 1e-9),
+                                "{what}: ball {k} outside"
+                            );
+                        }
+                    }
+                    assert!(min_gap(&s, &st) >= -1e-9, "{what}: overlap");
+                }
+            }
+        }
+    }
+}

@@ -443,28 +443,48 @@ where
         let now = self.now;
         let Some(border) = self.border else { return };
         self.clusters[c].sync(now);
-        // The member deepest towards that wall.
+        // The members touching that wall. Several can touch at once (a cluster landing
+        // flat); one impulse at a time would alternate between them forever. The wall
+        // reacts at one point of the hull of the contact points: the point nearest the
+        // projection of the centre of mass, which bounces a flat cluster without spin.
+        // (Per tangent axis this is a clamp: exact for the 2D clusters the engine runs.)
         let body = &self.clusters[c];
-        let mut best = (0, T::INFINITY);
-        for k in 0..body.members.len() {
+        let gap_of = |k: usize| {
             let (p, _) = body.member_state(k, now);
             let r = self.balls.radius[body.members[k] as usize];
-            let gap = if upper {
+            if upper {
                 border.max()[axis] - p[axis] - r
             } else {
                 p[axis] - r - border.min()[axis]
-            };
-            if gap < best.1 {
-                best = (k, gap);
             }
-        }
-        let member = body.members[best.0] as usize;
-        let (p, _) = body.member_state(best.0, now);
+        };
+        let deepest = (0..body.members.len())
+            .map(gap_of)
+            .fold(T::INFINITY, T::min);
+        let touching = deepest + T::lit(1e-9) * self.length_scale;
         let mut n = Vector::<T, D>::zeros();
         n[axis] = if upper { T::one() } else { -T::one() };
-        let r = self.balls.radius[member];
+        let (mut lo, mut hi) = (
+            Vector::<T, D>::repeat(T::INFINITY),
+            Vector::<T, D>::repeat(-T::INFINITY),
+        );
+        let mut member = body.members[0] as usize;
+        for k in (0..body.members.len()).filter(|&k| gap_of(k) <= touching) {
+            let (p, _) = body.member_state(k, now);
+            let q = p + n * self.balls.radius[body.members[k] as usize];
+            lo = lo.inf(&q);
+            hi = hi.sup(&q);
+            member = body.members[k] as usize;
+        }
+        let com = body.rigid.center();
+        let mut point = Vector::<T, D>::from_fn(|m, _| com[m].max(lo[m]).min(hi[m]));
+        point[axis] = if upper {
+            border.max()[axis]
+        } else {
+            border.min()[axis]
+        };
         // The cluster is body a, the wall body b; the normal points into the wall.
-        let contact = Contact::new_unchecked(n, p + n * r - body.rigid.center(), Vector::zeros());
+        let contact = Contact::new_unchecked(n, point - com, Vector::zeros());
         let e = self.surface_restitution(member, self.border_restitution);
         let response = resolve(
             &body.rigid.body(),
