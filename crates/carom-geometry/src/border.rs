@@ -102,6 +102,7 @@ impl<T: Real, const D: usize> Border<T, D> {
     /// A point at most one period outside (a ball that just crossed a face) is shifted by
     /// one period with a comparison; only points farther away use the general
     /// `floor` formula.
+    #[inline]
     pub fn wrap(&self, p: &Vector<T, D>) -> Vector<T, D> {
         let (lo, hi, len) = (self.min(), self.max(), self.extents());
         Vector::<T, D>::from_fn(|i, _| {
@@ -131,6 +132,7 @@ impl<T: Real, const D: usize> Border<T, D> {
     ///
     /// Separations of points inside the box are within one period, and are shifted with
     /// a comparison; only larger ones use `round`.
+    #[inline]
     pub fn minimum_image(&self, delta: &Vector<T, D>) -> Vector<T, D> {
         let len = self.extents();
         Vector::<T, D>::from_fn(|i, _| {

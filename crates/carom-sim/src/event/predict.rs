@@ -118,15 +118,18 @@ where
         best: &mut Best<T>,
     ) {
         let now = self.now;
+        let periodic = self.periodic_border();
+        let centre = ball.center();
         let mut consider = |j: usize| {
             if j == i || matches!(self.balls.mode[j], Mode::Stuck(_)) {
                 return;
             }
-            let pj = self.balls.position_at(j, now);
-            let other = Ball::new_unchecked(
-                ball.center() + self.separation(&ball.center(), &pj),
-                self.balls.radius[j],
-            );
+            let d = self.balls.position_at(j, now) - centre;
+            let d = match periodic {
+                Some(border) => border.minimum_image(&d),
+                None => d,
+            };
+            let other = Ball::new_unchecked(centre + d, self.balls.radius[j]);
             let kin_j =
                 Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel[j]);
             if let Some(s) = ball_ball(ball, kin, &other, &kin_j, &best.window(now)).hit_time() {
