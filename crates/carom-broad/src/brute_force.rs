@@ -61,7 +61,11 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for BruteForce<T, D> {
 
     fn query_aabb(&self, query: &Aabb<T, D>, out: &mut Vec<u32>) {
         out.clear();
-        out.extend((0..self.store.len()).filter(|&j| self.store.hits_box(j, query)).map(|j| j as u32));
+        out.extend(
+            (0..self.store.len())
+                .filter(|&j| self.store.hits_box(j, query))
+                .map(|j| j as u32),
+        );
     }
 
     fn query_ball(&self, center: &Vector<T, D>, radius: T, out: &mut Vec<u32>) {

@@ -86,11 +86,15 @@ impl<const D: usize> Geometry<D> {
     fn bucket(&self, c: &Cell<D>) -> usize {
         if self.hashed {
             const PRIMES: [u64; 3] = [73_856_093, 19_349_663, 83_492_791];
-            let h = (0..D).fold(0u64, |h, k| h ^ (c[k] as u64).wrapping_mul(PRIMES[k % 3] << (k / 3)));
+            let h = (0..D).fold(0u64, |h, k| {
+                h ^ (c[k] as u64).wrapping_mul(PRIMES[k % 3] << (k / 3))
+            });
             let bits = self.buckets.trailing_zeros();
             (h.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - bits)) as usize
         } else {
-            (0..D).rev().fold(0usize, |b, k| b * self.dims[k] as usize + c[k] as usize)
+            (0..D)
+                .rev()
+                .fold(0usize, |b, k| b * self.dims[k] as usize + c[k] as usize)
         }
     }
 
@@ -117,7 +121,9 @@ impl<const D: usize> Geometry<D> {
     /// The unwrapped cell-coordinate range covering `[lo, hi]` on every axis.
     fn range(&self, lo: &[f64; D], hi: &[f64; D]) -> ([i64; D], [i64; D]) {
         let f = |p: &[f64; D], k: usize| {
-            ((p[k] - self.origin[k]) * self.inv_cell[k]).floor().clamp(-4e18, 4e18) as i64
+            ((p[k] - self.origin[k]) * self.inv_cell[k])
+                .floor()
+                .clamp(-4e18, 4e18) as i64
         };
         let mut a: [i64; D] = core::array::from_fn(|k| f(lo, k));
         let mut b: [i64; D] = core::array::from_fn(|k| f(hi, k));
@@ -142,7 +148,7 @@ fn forward_offsets<const D: usize>() -> Vec<Cell<D>> {
     for code in 0..3usize.pow(D as u32) {
         let mut rest = code;
         let o: Cell<D> = core::array::from_fn(|_| {
-            let d = (rest % 3) as i32 - 1;
+            let d = [-1, 0, 1][rest % 3];
             rest /= 3;
             d
         });
@@ -261,7 +267,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         }
         let eps = T::EPSILON.to_f64();
         let mut width = cell_width * (1.0 + 1.0 / 1024.0) + 16.0 * eps * scale;
-        if !(width > 0.0) {
+        if width.is_nan() || width <= 0.0 {
             width = 1.0;
         }
         let max_cells = (8 * n + 64) as f64;
@@ -301,7 +307,9 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                 }
                 let span = (0..D).fold(0.0_f64, |s, k| s.max(hi[k] - lo[k]));
                 width = width.max(span / MAX_CELLS_PER_AXIS);
-                let dims_for = |w: f64| -> [i64; D] { core::array::from_fn(|k| ((hi[k] - lo[k]) / w).floor() as i64 + 1) };
+                let dims_for = |w: f64| -> [i64; D] {
+                    core::array::from_fn(|k| ((hi[k] - lo[k]) / w).floor() as i64 + 1)
+                };
                 let mut dims = dims_for(width);
                 if !hashed {
                     let total: f64 = dims.iter().map(|&d| d as f64).product();
@@ -342,7 +350,11 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                 let mut cur = a;
                 'cells: loop {
                     let cell: Cell<D> = core::array::from_fn(|k| {
-                        if g.periodic { cur[k].rem_euclid(g.dims[k]) as i32 } else { cur[k] as i32 }
+                        if g.periodic {
+                            cur[k].rem_euclid(g.dims[k]) as i32
+                        } else {
+                            cur[k] as i32
+                        }
                     });
                     let bucket = g.bucket(&cell);
                     for m in self.start[bucket] as usize..self.start[bucket + 1] as usize {
@@ -384,9 +396,13 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                     }
                 }
                 for offset in &self.offsets {
-                    let Some(cell) = g.neighbour(&a.cell, offset) else { continue };
+                    let Some(cell) = g.neighbour(&a.cell, offset) else {
+                        continue;
+                    };
                     let bucket = g.bucket(&cell);
-                    for b in &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize] {
+                    for b in
+                        &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
+                    {
                         if b.cell == cell && overlap(&a.proxy, &b.proxy, balls, period) {
                             emit.push(a.id, b.id);
                         }
@@ -406,7 +422,13 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             });
         }
         if period.is_some() {
-            for (x, &i) in self.oversized.iter().enumerate().skip(oversized.start).take(oversized.len()) {
+            for (x, &i) in self
+                .oversized
+                .iter()
+                .enumerate()
+                .skip(oversized.start)
+                .take(oversized.len())
+            {
                 for &j in &self.oversized[x + 1..] {
                     if self.store.overlap(i as usize, j as usize) {
                         emit.push(i, j);
@@ -421,7 +443,13 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
 
     /// Query helper: regular candidates near `[lo, hi]` grown by the reach, and the
     /// oversized ones, filtered by `hit`.
-    fn query(&self, lo: &Vector<T, D>, hi: &Vector<T, D>, hit: impl Fn(usize) -> bool, out: &mut Vec<u32>) {
+    fn query(
+        &self,
+        lo: &Vector<T, D>,
+        hi: &Vector<T, D>,
+        hit: impl Fn(usize) -> bool,
+        out: &mut Vec<u32>,
+    ) {
         out.clear();
         let lo64 = core::array::from_fn(|k| lo[k].to_f64() - self.reach);
         let hi64 = core::array::from_fn(|k| hi[k].to_f64() + self.reach);
@@ -451,13 +479,18 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
         let n = self.store.len();
 
         self.extents.clear();
-        self.extents.extend(self.store.proxies.iter().map(|p| p.extent().to_f64()));
+        self.extents
+            .extend(self.store.proxies.iter().map(|p| p.extent().to_f64()));
         let threshold = if n == 0 {
             0.0
         } else {
             self.selection.clear();
             self.selection.extend_from_slice(&self.extents);
-            self.oversize_ratio * *self.selection.select_nth_unstable_by(n / 2, f64::total_cmp).1
+            self.oversize_ratio
+                * *self
+                    .selection
+                    .select_nth_unstable_by(n / 2, f64::total_cmp)
+                    .1
         };
         self.regular.clear();
         self.oversized.clear();
@@ -490,7 +523,10 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
             self.buckets_of.clear();
             self.start.resize(g.buckets + 1, 0);
             for &i in &self.regular {
-                let c = self.store.proxies[i as usize].center.map(Real::to_f64).into();
+                let c = self.store.proxies[i as usize]
+                    .center
+                    .map(Real::to_f64)
+                    .into();
                 let cell = g.cell(&c);
                 let bucket = g.bucket(&cell);
                 self.cells.push(cell);
@@ -522,7 +558,8 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
             self.start[0] = 0;
         }
         if self.store.period.is_none() {
-            self.oversized_sweep.build(&self.store, Some(&self.oversized), SortPolicy::Radix);
+            self.oversized_sweep
+                .build(&self.store, Some(&self.oversized), SortPolicy::Radix);
         }
     }
 
@@ -534,22 +571,36 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
         let n = self.store.len();
         let mut buffers = core::mem::take(&mut self.buffers);
         buffers.prepare(n, 1, 1);
-        self.search(0..self.entries.len(), 0..self.oversized.len(), &mut buffers.emitter());
+        self.search(
+            0..self.entries.len(),
+            0..self.oversized.len(),
+            &mut buffers.emitter(),
+        );
         buffers.sort_into(out);
         self.buffers = buffers;
     }
 
     fn query_aabb(&self, query: &Aabb<T, D>, out: &mut Vec<u32>) {
-        self.query(&query.min(), &query.max(), |j| self.store.hits_box(j, query), out);
+        self.query(
+            &query.min(),
+            &query.max(),
+            |j| self.store.hits_box(j, query),
+            out,
+        );
     }
 
     fn query_ball(&self, center: &Vector<T, D>, radius: T, out: &mut Vec<u32>) {
-        if !(radius >= T::zero()) {
+        if !radius.finite() || radius < T::zero() {
             out.clear();
             return;
         }
         let r = Vector::<T, D>::repeat(radius);
-        self.query(&(center - r), &(center + r), |j| self.store.hits_ball(j, center, radius), out);
+        self.query(
+            &(center - r),
+            &(center + r),
+            |j| self.store.hits_ball(j, center, radius),
+            out,
+        );
     }
 }
 
@@ -562,10 +613,14 @@ impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for UniformGrid<T,
         let mut buffers = core::mem::take(&mut self.buffers);
         buffers.prepare(n, chunks, chunks);
         let this = &*self;
-        buffers.emitters().into_par_iter().enumerate().for_each(|(c, mut emit)| {
-            let regular = crate::chunk_range(c, chunks, r);
-            this.search(regular, crate::chunk_range(c, chunks, m), &mut emit);
-        });
+        buffers
+            .emitters()
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, mut emit)| {
+                let regular = crate::chunk_range(c, chunks, r);
+                this.search(regular, crate::chunk_range(c, chunks, m), &mut emit);
+            });
         buffers.par_sort_into(out);
         self.buffers = buffers;
     }

@@ -121,7 +121,12 @@ impl<T: Real, const D: usize> KdTree<T, D> {
     /// Emits the pairs found by the tree queries of volumes `ids` (a tree volume keeps
     /// only larger tree indices; an oversized one keeps every tree hit), and by the
     /// sweep of the oversized volumes at sorted positions `oversized`.
-    fn search(&self, ids: core::ops::Range<usize>, oversized: core::ops::Range<usize>, emit: &mut Emitter<'_>) {
+    fn search(
+        &self,
+        ids: core::ops::Range<usize>,
+        oversized: core::ops::Range<usize>,
+        emit: &mut Emitter<'_>,
+    ) {
         let proxies = &self.store.proxies;
         for i in ids {
             let p = &proxies[i];
@@ -135,10 +140,18 @@ impl<T: Real, const D: usize> KdTree<T, D> {
                 }
             });
         }
-        self.oversized_sweep.sweep(oversized, self.store.balls, emit);
+        self.oversized_sweep
+            .sweep(oversized, self.store.balls, emit);
     }
 
-    fn query(&self, center: &Vector<T, D>, radius: f64, hit: impl Fn(usize) -> bool, lo_hi: (T, T), out: &mut Vec<u32>) {
+    fn query(
+        &self,
+        center: &Vector<T, D>,
+        radius: f64,
+        hit: impl Fn(usize) -> bool,
+        lo_hi: (T, T),
+        out: &mut Vec<u32>,
+    ) {
         out.clear();
         let c = center.map(Real::to_f64).into();
         self.visit_tree(&c, self.reach(radius), |j| {
@@ -183,7 +196,8 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for KdTree<T, D> {
             self.in_tree.push(regular);
             if regular {
                 tree_radius = tree_radius.max(r);
-                self.entries.push((i as u32, p.center.map(Real::to_f64).into()));
+                self.entries
+                    .push((i as u32, p.center.map(Real::to_f64).into()));
             } else {
                 self.oversized.push(i as u32);
             }
@@ -203,7 +217,8 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for KdTree<T, D> {
             self.oversized.clear();
             self.oversized.extend(0..n as u32);
         }
-        self.oversized_sweep.build(&self.store, Some(&self.oversized), SortPolicy::Radix);
+        self.oversized_sweep
+            .build(&self.store, Some(&self.oversized), SortPolicy::Radix);
     }
 
     fn len(&self) -> usize {
@@ -234,7 +249,7 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for KdTree<T, D> {
     }
 
     fn query_ball(&self, center: &Vector<T, D>, radius: T, out: &mut Vec<u32>) {
-        if !(radius >= T::zero()) {
+        if !radius.finite() || radius < T::zero() {
             out.clear();
             return;
         }
@@ -258,10 +273,14 @@ impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for KdTree<T, D> {
         let mut buffers = core::mem::take(&mut self.buffers);
         buffers.prepare(n, chunks, chunks);
         let this = &*self;
-        buffers.emitters().into_par_iter().enumerate().for_each(|(c, mut emit)| {
-            let ids = crate::chunk_range(c, chunks, n);
-            this.search(ids, crate::chunk_range(c, chunks, m), &mut emit);
-        });
+        buffers
+            .emitters()
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, mut emit)| {
+                let ids = crate::chunk_range(c, chunks, n);
+                this.search(ids, crate::chunk_range(c, chunks, m), &mut emit);
+            });
         buffers.par_sort_into(out);
         self.buffers = buffers;
     }

@@ -80,8 +80,8 @@ pub trait BroadPhase<T: Real, const D: usize> {
     /// Writes the indices of the volumes that intersect the ball `(center, radius)`
     /// (touching counts) into `out` (cleared first), ascending. A ball volume `j` is
     /// hit when `|c_j − center| <= r_j + radius`: querying ball `i` with
-    /// `radius = r_i + shell` gives its neighbours within a shell. A negative radius
-    /// hits nothing.
+    /// `radius = r_i + shell` gives its neighbours within a shell. A negative or
+    /// non-finite radius hits nothing.
     fn query_ball(&self, center: &Vector<T, D>, radius: T, out: &mut Vec<u32>);
 }
 

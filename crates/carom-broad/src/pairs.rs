@@ -247,7 +247,7 @@ mod tests {
         let mut buffers = PairBuffers::default();
         buffers.prepare(10, 1, 3);
         let mut e = buffers.emitter();
-        for (a, b) in [(9, 2), (0, 5), (2, 3), (0, 1), (7, 8), (5, 0 + 4)] {
+        for (a, b) in [(9, 2), (0, 5), (2, 3), (0, 1), (7, 8), (5, 4)] {
             e.push(a, b);
         }
         let mut out = Vec::new();

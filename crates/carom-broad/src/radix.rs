@@ -61,7 +61,11 @@ const BUCKETS: usize = 1 << RADIX_BITS;
 /// Stable LSD radix sort of `entries` by their key (the high 32 bits), in three passes
 /// of 11 bits; a pass whose digits are all equal is skipped (Terdiman's check). If the
 /// entries were in index order, the result is sorted by `(key, index)`.
-pub(crate) fn radix_sort_by_key(entries: &mut Vec<u64>, scratch: &mut Vec<u64>, counts: &mut Vec<usize>) {
+pub(crate) fn radix_sort_by_key(
+    entries: &mut Vec<u64>,
+    scratch: &mut Vec<u64>,
+    counts: &mut Vec<usize>,
+) {
     scratch.clear();
     scratch.resize(entries.len(), 0);
     counts.clear();
@@ -69,11 +73,11 @@ pub(crate) fn radix_sort_by_key(entries: &mut Vec<u64>, scratch: &mut Vec<u64>, 
     for pass in 0..3u32 {
         let shift = 32 + pass * RADIX_BITS;
         let digit = |e: u64| ((e >> shift) as usize) & (BUCKETS - 1);
-        counts.iter_mut().for_each(|c| *c = 0);
+        counts.fill(0);
         for &e in entries.iter() {
             counts[digit(e)] += 1;
         }
-        if counts.iter().any(|&c| c == entries.len()) {
+        if counts.contains(&entries.len()) {
             continue;
         }
         let mut sum = 0;
@@ -118,7 +122,18 @@ mod tests {
 
     #[test]
     fn keys_preserve_order_and_round_outward() {
-        let xs = [-1e300, -3.5, -1e-30, -0.0, 0.0, 1e-30, 0.1, 1.0, 1e6 + 0.3, 1e300];
+        let xs = [
+            -1e300,
+            -3.5,
+            -1e-30,
+            -0.0,
+            0.0,
+            1e-30,
+            0.1,
+            1.0,
+            1e6 + 0.3,
+            1e300,
+        ];
         for w in xs.windows(2) {
             assert!(key_down(w[0]) <= key_down(w[1]));
             assert!(key_up(w[0]) <= key_up(w[1]));
@@ -137,7 +152,9 @@ mod tests {
     fn radix_and_insertion_sorts_agree_with_the_standard_sort() {
         let mut state = 12345u64;
         let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 33) as u32
         };
         let mut entries: Vec<u64> = (0..5000).map(|i| entry(next() % 700, i)).collect();

@@ -117,7 +117,7 @@ impl<T: Real, const D: usize> Scene<T, D> {
     /// `n` balls of radius `radius` uniform in a cube sized for packing `fraction`,
     /// the cube starting at `offset` on every axis (`1e6` for far-from-origin scenes).
     pub fn uniform(n: usize, radius: f64, fraction: f64, offset: f64, seed: u64) -> Self {
-        let side = Self::side(n, unit_ball(D) * radius.powi(D as i32), fraction);
+        let side = Self::side(n, unit_ball(D) * radius.powf(D as f64), fraction);
         let mut s = Self::with_domain(side, offset, seed);
         for _ in 0..n {
             let c = s.uniform_point(side, offset);
@@ -129,15 +129,18 @@ impl<T: Real, const D: usize> Scene<T, D> {
 
     /// `n` balls of radius `radius` in `clusters` clumps, the domain sized for `fraction`.
     pub fn clustered(n: usize, radius: f64, fraction: f64, clusters: usize, seed: u64) -> Self {
-        let side = Self::side(n, unit_ball(D) * radius.powi(D as i32), fraction);
+        let side = Self::side(n, unit_ball(D) * radius.powf(D as f64), fraction);
         let mut s = Self::with_domain(side, 0.0, seed);
-        let hubs: Vec<Vector<T, D>> = (0..clusters.max(1)).map(|_| s.uniform_point(side, 0.0)).collect();
+        let hubs: Vec<Vector<T, D>> = (0..clusters.max(1))
+            .map(|_| s.uniform_point(side, 0.0))
+            .collect();
         let spread = 0.1 * side;
         for i in 0..n {
             let hub = hubs[i % hubs.len()];
             let dir = s.rng.direction::<D>();
             let dist = spread * s.rng.next_f64().powf(1.0 / D as f64);
-            s.centers.push(hub + Vector::<T, D>::from_fn(|k, _| T::lit(dir[k] * dist)));
+            s.centers
+                .push(hub + Vector::<T, D>::from_fn(|k, _| T::lit(dir[k] * dist)));
             s.radii.push(T::lit(radius));
         }
         s
@@ -149,7 +152,11 @@ impl<T: Real, const D: usize> Scene<T, D> {
         let mut rng = SplitMix64::new(seed ^ 0x5EED);
         let (a, b) = (r_min.ln(), r_max.ln());
         let radii: Vec<f64> = (0..n).map(|_| rng.range(a, b).exp()).collect();
-        let content = radii.iter().map(|r| unit_ball(D) * r.powi(D as i32)).sum::<f64>() / n.max(1) as f64;
+        let content = radii
+            .iter()
+            .map(|r| unit_ball(D) * r.powf(D as f64))
+            .sum::<f64>()
+            / n.max(1) as f64;
         let side = Self::side(n, content, fraction);
         let mut s = Self::with_domain(side, 0.0, seed);
         for r in radii {
@@ -162,12 +169,13 @@ impl<T: Real, const D: usize> Scene<T, D> {
 
     /// `n` random boxes with mean edge `edge`, uniform in a cube sized for `fraction`.
     pub fn boxes(n: usize, edge: f64, fraction: f64, seed: u64) -> Self {
-        let side = Self::side(n, edge.powi(D as i32), fraction);
+        let side = Self::side(n, edge.powf(D as f64), fraction);
         let mut s = Self::with_domain(side, 0.0, seed);
         for _ in 0..n {
             let c = s.uniform_point(side, 0.0);
             let half = Vector::<T, D>::from_fn(|_, _| T::lit(0.5 * edge * s.rng.range(0.5, 1.5)));
-            let b = Aabb::from_center_half_extents(c, half).unwrap_or_else(|_| Aabb::new_unchecked(c, c));
+            let b = Aabb::from_center_half_extents(c, half)
+                .unwrap_or_else(|_| Aabb::new_unchecked(c, c));
             s.centers.push(c);
             s.radii.push(half.norm());
             s.boxes.push(b);
@@ -220,7 +228,11 @@ mod tests {
         let side = s.domain.extents()[0];
         let fraction = 1000.0 * 4.0 / 3.0 * core::f64::consts::PI * 0.125 / side.powi(3);
         assert!((fraction - 0.1).abs() < 1e-12);
-        assert!(s.centers.iter().all(|c| c.iter().all(|&x| (0.0..side).contains(&x))));
+        assert!(
+            s.centers
+                .iter()
+                .all(|c| c.iter().all(|&x| (0.0..side).contains(&x)))
+        );
     }
 
     #[test]

@@ -86,15 +86,20 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
     /// Sorts the volumes `ids` of `store` (all of them when `ids` is `None`).
     pub(crate) fn build(&mut self, store: &Store<T, D>, ids: Option<&[u32]>, policy: SortPolicy) {
         // A subset's members change between frames: its previous order means nothing.
-        let policy = if ids.is_some() { SortPolicy::Radix } else { policy };
+        let policy = if ids.is_some() {
+            SortPolicy::Radix
+        } else {
+            policy
+        };
         let proxies = &store.proxies;
         let n = ids.map_or(proxies.len(), <[u32]>::len);
         let id_at = |k: usize| ids.map_or(k as u32, |ids| ids[k]);
 
         let (best_axis, variances) = axis_variances(n, |k| &proxies[id_at(k) as usize]);
         let same_count = self.entries.len() == n && !self.entries.is_empty();
-        let keep_axis =
-            policy == SortPolicy::Adaptive && same_count && variances[best_axis] <= 2.0 * variances[self.axis];
+        let keep_axis = policy == SortPolicy::Adaptive
+            && same_count
+            && variances[best_axis] <= 2.0 * variances[self.axis];
         if !keep_axis {
             self.axis = best_axis;
         }
@@ -104,14 +109,13 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
 
         self.last_sort = SortKind::None;
         if n >= 2 {
-            let coherent = keep_axis
-                && {
-                    for e in &mut self.entries {
-                        let id = entry_id(*e);
-                        *e = entry(key_of(id), id);
-                    }
-                    insertion_sort_bounded(&mut self.entries, 4 * n)
-                };
+            let coherent = keep_axis && {
+                for e in &mut self.entries {
+                    let id = entry_id(*e);
+                    *e = entry(key_of(id), id);
+                }
+                insertion_sort_bounded(&mut self.entries, 4 * n)
+            };
             if coherent {
                 self.last_sort = SortKind::Insertion;
             } else {
@@ -125,7 +129,8 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
             }
         } else {
             self.entries.clear();
-            self.entries.extend((0..n).map(|k| entry(key_of(id_at(k)), id_at(k))));
+            self.entries
+                .extend((0..n).map(|k| entry(key_of(id_at(k)), id_at(k))));
         }
 
         self.key_min.clear();
@@ -134,7 +139,10 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         for &e in &self.entries {
             let id = entry_id(e);
             let proxy = proxies[id as usize];
-            let (lo, hi) = (proxy.aabb.min()[axis].to_f64(), proxy.aabb.max()[axis].to_f64());
+            let (lo, hi) = (
+                proxy.aabb.min()[axis].to_f64(),
+                proxy.aabb.max()[axis].to_f64(),
+            );
             max_extent = max_extent.max(hi - lo);
             self.key_min.push(entry_key(e));
             self.sorted.push(Sorted {
@@ -154,7 +162,12 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
 
     /// Sweeps the sorted positions `range`, emitting every overlapping pair whose first
     /// volume (in sweep order) is in `range`.
-    pub(crate) fn sweep(&self, range: core::ops::Range<usize>, balls: bool, emit: &mut Emitter<'_>) {
+    pub(crate) fn sweep(
+        &self,
+        range: core::ops::Range<usize>,
+        balls: bool,
+        emit: &mut Emitter<'_>,
+    ) {
         let axis = self.axis;
         for k in range {
             let a = &self.sorted[k];
@@ -182,7 +195,8 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         let n = self.len();
         // Grow the extent by a few ulp so that its rounding cannot shrink the window,
         // then step one f32 below the key of the difference to cover its rounding.
-        let from = key_down(lo.to_f64() - self.max_extent * (1.0 + 4.0 * f64::EPSILON)).saturating_sub(1);
+        let from =
+            key_down(lo.to_f64() - self.max_extent * (1.0 + 4.0 * f64::EPSILON)).saturating_sub(1);
         let to = key_up(hi.to_f64());
         let first = self.key_min[..n].partition_point(|&k| k < from);
         let last = self.key_min[..n].partition_point(|&k| k <= to);
@@ -287,13 +301,19 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for SweepAndPrune<T, D> {
     fn pairs(&mut self, out: &mut Vec<Pair>) {
         let n = self.store.len();
         self.buffers.prepare(n, 1, 1);
-        self.core.sweep(0..n, self.store.balls, &mut self.buffers.emitter());
+        self.core
+            .sweep(0..n, self.store.balls, &mut self.buffers.emitter());
         self.buffers.sort_into(out);
     }
 
     fn query_aabb(&self, query: &Aabb<T, D>, out: &mut Vec<u32>) {
         let axis = self.core.axis();
-        self.query(query.min()[axis], query.max()[axis], |j| self.store.hits_box(j, query), out);
+        self.query(
+            query.min()[axis],
+            query.max()[axis],
+            |j| self.store.hits_box(j, query),
+            out,
+        );
     }
 
     fn query_ball(&self, center: &Vector<T, D>, radius: T, out: &mut Vec<u32>) {
@@ -315,7 +335,9 @@ impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for SweepAndPrune<
             .emitters()
             .into_par_iter()
             .enumerate()
-            .for_each(|(c, mut emit)| core.sweep(crate::chunk_range(c, chunks, n), balls, &mut emit));
+            .for_each(|(c, mut emit)| {
+                core.sweep(crate::chunk_range(c, chunks, n), balls, &mut emit);
+            });
         self.buffers.par_sort_into(out);
     }
 }
@@ -328,13 +350,17 @@ mod tests {
 
     #[test]
     fn coherent_frames_use_insertion_sort_and_incoherent_ones_fall_back() {
-        let mut centers: Vec<_> = (0..200).map(|i| Vector2::new(f64::from(i) * 0.7, 0.0)).collect();
+        let mut centers: Vec<_> = (0..200)
+            .map(|i| Vector2::new(f64::from(i) * 0.7, 0.0))
+            .collect();
         let radii = vec![0.5; 200];
         let mut sap = SweepAndPrune::new();
         sap.update(Balls::new(&centers, &radii).unwrap().into());
         assert_eq!(sap.last_sort(), SortKind::Radix);
         assert_eq!(sap.axis(), 0);
-        centers.iter_mut().for_each(|c| c.x += 0.01);
+        for c in &mut centers {
+            c.x += 0.01;
+        }
         sap.update(Balls::new(&centers, &radii).unwrap().into());
         assert_eq!(sap.last_sort(), SortKind::Insertion);
         centers.reverse();

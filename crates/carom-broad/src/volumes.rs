@@ -23,7 +23,7 @@
 //! * in a periodic domain (grid and brute force only) the separation of centres is
 //!   the minimum image, and boxes overlap when `|Δ_k| <= h_a[k] + h_b[k]` per axis.
 
-use carom_geometry::{Aabb, BoundingVolume, Border};
+use carom_geometry::{Aabb, Border, BoundingVolume};
 use carom_math::{InvalidValue, Problem, Real, Vector, ensure_finite_vector, ensure_non_negative};
 
 /// Bounding volumes for one update: boxes or balls.
@@ -318,14 +318,16 @@ impl<T: Real, const D: usize> Store<T, D> {
         match &self.period {
             None => {
                 boxes_overlap(&p.aabb, query)
-                    && (!self.balls || box_distance_squared(query, &p.center) <= p.radius * p.radius)
+                    && (!self.balls
+                        || box_distance_squared(query, &p.center) <= p.radius * p.radius)
             }
             Some(period) => {
                 // Move the query to the image nearest to the volume, then test as usual.
                 let shift = minimum_image(&(q.center - p.center), period) - (q.center - p.center);
                 let moved = query.translated(&shift);
                 boxes_overlap(&p.aabb, &moved)
-                    && (!self.balls || box_distance_squared(&moved, &p.center) <= p.radius * p.radius)
+                    && (!self.balls
+                        || box_distance_squared(&moved, &p.center) <= p.radius * p.radius)
             }
         }
     }
@@ -339,7 +341,10 @@ impl<T: Real, const D: usize> Store<T, D> {
             Some(period) => p.center + minimum_image(&(center - p.center), period),
         };
         let r = Vector::<T, D>::repeat(radius);
-        if !(radius >= T::zero()) || !boxes_overlap(&p.aabb, &Aabb::new_unchecked(c - r, c + r)) {
+        if !radius.finite()
+            || radius < T::zero()
+            || !boxes_overlap(&p.aabb, &Aabb::new_unchecked(c - r, c + r))
+        {
             return false;
         }
         if self.balls {
@@ -362,7 +367,10 @@ mod tests {
         let e = Balls::new(&c, &[1.0, 1.0]).unwrap_err();
         assert_eq!(e.field, "centers[1].center[1]");
         let c = [Vector2::new(0.0, 0.0)];
-        assert_eq!(Balls::new(&c, &[-1.0]).unwrap_err().field, "radii[0].radius");
+        assert_eq!(
+            Balls::new(&c, &[-1.0]).unwrap_err().field,
+            "radii[0].radius"
+        );
         assert_eq!(Balls::new(&c, &[1.0, 2.0]).unwrap_err().field, "radii");
         let b = Balls::new(&c, &[1.0]).unwrap();
         assert_eq!(b.with_margin(-0.5).unwrap_err().field, "margin");
