@@ -20,7 +20,8 @@
 //!
 //! One big volume makes every query as large as it is: with radii from `1e-3` to `1`,
 //! each query for a tiny ball covers a ball of radius `1` and visits hundreds of
-//! centres. So volumes with `R > oversize_ratio × median(R)` (default 4) are kept out of
+//! centres. So volumes with `R > oversize_ratio × median(R)` (default 4; the median estimated from at
+//! most 1025 strided samples) are kept out of
 //! the tree: they query the tree with their own radius (one large query each) and are
 //! swept against each other by a sweep-and-prune. This keeps small-ball queries small;
 //! when a large fraction of the volumes is oversized the sweep dominates, and
@@ -38,7 +39,7 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use crate::pairs::{Emitter, PairBuffers};
 use crate::sweep::{SortPolicy, SweepCore};
-use crate::volumes::Store;
+use crate::volumes::{Store, sampled_median};
 use crate::{BroadPhase, Pair, Volumes};
 
 /// A k-d tree broad phase over boxes or balls, in open space.
@@ -174,13 +175,7 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for KdTree<T, D> {
         let proxies = &self.store.proxies;
         let n = proxies.len();
 
-        self.radii.clear();
-        self.radii.extend(proxies.iter().map(|p| p.radius.to_f64()));
-        let median = if n == 0 {
-            0.0
-        } else {
-            *self.radii.select_nth_unstable_by(n / 2, f64::total_cmp).1
-        };
+        let median = sampled_median(n, |i| proxies[i].radius.to_f64(), &mut self.radii);
         let threshold = self.oversize_ratio * median;
 
         // kiddo rejects coordinates equal to f64::MAX; such volumes go to the sweep.

@@ -87,7 +87,7 @@ pub trait BroadPhase<T: Real, const D: usize> {
 
 /// A broad phase whose pair finding runs in parallel with rayon.
 #[cfg(feature = "parallel")]
-pub trait ParallelBroadPhase<T: Real, const D: usize>: BroadPhase<T, D> {
+pub trait ParallelBroadPhase<T: Real, const D: usize>: BroadPhase<T, D> + Send {
     /// [`BroadPhase::pairs`] on the current rayon thread pool; the result is identical.
     fn par_pairs(&mut self, out: &mut Vec<Pair>);
 }

@@ -9,8 +9,7 @@
 //! * [`Scene::clustered`]: equal balls in `clusters` dense clumps (uniform in a ball of
 //!   a tenth of the domain's width around uniform cluster centres).
 //! * [`Scene::mixed`]: radii log-uniform in `[r_min, r_max]`, uniform positions.
-//! * [`Scene::boxes`]: random boxes (Terdiman's benchmark input): uniform centres, each
-//!   edge uniform in `[0.5, 1.5] × mean`.
+//! * [`Scene::boxes`]: random boxes as in Terdiman's box-pruning test.
 //! * [`Scene::step`]: one coherent frame: every ball moves by a fixed fraction of its
 //!   radius in a random direction.
 
@@ -167,13 +166,15 @@ impl<T: Real, const D: usize> Scene<T, D> {
         s
     }
 
-    /// `n` random boxes with mean edge `edge`, uniform in a cube sized for `fraction`.
-    pub fn boxes(n: usize, edge: f64, fraction: f64, seed: u64) -> Self {
-        let side = Self::side(n, edge.powf(D as f64), fraction);
-        let mut s = Self::with_domain(side, 0.0, seed);
+    /// `n` random boxes as in Terdiman's box-pruning test: centres uniform in
+    /// `[−spread/2, spread/2]^D`, half extents uniform in `[0, max_half_extent)` per
+    /// axis (his figures use spread 2000 and half extents up to 20). The radii are the
+    /// boxes' half diagonals.
+    pub fn boxes(n: usize, spread: f64, max_half_extent: f64, seed: u64) -> Self {
+        let mut s = Self::with_domain(spread, -0.5 * spread, seed);
         for _ in 0..n {
-            let c = s.uniform_point(side, 0.0);
-            let half = Vector::<T, D>::from_fn(|_, _| T::lit(0.5 * edge * s.rng.range(0.5, 1.5)));
+            let c = s.uniform_point(spread, -0.5 * spread);
+            let half = Vector::<T, D>::from_fn(|_, _| T::lit(s.rng.range(0.0, max_half_extent)));
             let b = Aabb::from_center_half_extents(c, half)
                 .unwrap_or_else(|_| Aabb::new_unchecked(c, c));
             s.centers.push(c);

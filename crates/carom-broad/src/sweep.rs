@@ -15,7 +15,9 @@
 //! * **Sorted struct-of-arrays.** The keys live in their own array (the inner loop
 //!   streams through it); the boxes, centres and indices are copied in sorted order next
 //!   to it, so a candidate's full test reads memory in sweep order, never at random.
-//! * **Prune on the other axes first**, then the shared exact predicate.
+//! * **Integer pruning on every axis**: the keys of all `D` axes are packed per volume
+//!   in sweep order (8 bytes per axis), so most candidates are rejected by integer
+//!   compares on one small record; only survivors read the exact volume.
 //! * **Incremental insertion sort** for coherent frames: the previous order is re-keyed
 //!   and insertion-sorted, `O(N + swaps)`. It gives up after `4N` moves and radix-sorts
 //!   instead, so an incoherent frame costs little more than a one-shot sort.
@@ -57,12 +59,22 @@ pub enum SortKind {
     Radix,
 }
 
-/// One volume in sweep order.
+/// The integer keys of a box on every axis (bounds rounded outward to `f32`): the
+/// sweep prunes on them, 8 bytes per axis, before it reads the exact volume.
 #[derive(Clone, Copy, Debug)]
-struct Sorted<T: Real, const D: usize> {
-    proxy: Proxy<T, D>,
-    key_max: u32,
-    id: u32,
+struct KeyBox<const D: usize> {
+    min: [u32; D],
+    max: [u32; D],
+}
+
+impl<const D: usize> KeyBox<D> {
+    fn of<T: Real>(proxy: &Proxy<T, D>) -> Self {
+        let (lo, hi) = (proxy.aabb.min(), proxy.aabb.max());
+        Self {
+            min: core::array::from_fn(|d| key_down(lo[d].to_f64())),
+            max: core::array::from_fn(|d| key_up(hi[d].to_f64())),
+        }
+    }
 }
 
 /// The sorted state of a sweep over some volumes of a [`Store`] (all of them, or a
@@ -76,9 +88,12 @@ pub(crate) struct SweepCore<T: Real, const D: usize> {
     entries: Vec<u64>,
     scratch: Vec<u64>,
     counts: Vec<usize>,
-    /// Sorted lower-bound keys and one `u32::MAX` sentinel.
+    /// Sorted lower-bound keys on the sweep axis and one `u32::MAX` sentinel.
     key_min: Vec<u32>,
-    sorted: Vec<Sorted<T, D>>,
+    /// In sweep order: the keys on every axis, the exact volume and its index.
+    keys: Vec<KeyBox<D>>,
+    proxies: Vec<Proxy<T, D>>,
+    ids: Vec<u32>,
     last_sort: SortKind,
 }
 
@@ -134,7 +149,9 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         }
 
         self.key_min.clear();
-        self.sorted.clear();
+        self.keys.clear();
+        self.proxies.clear();
+        self.ids.clear();
         let mut max_extent = 0.0_f64;
         for &e in &self.entries {
             let id = entry_id(e);
@@ -145,11 +162,9 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
             );
             max_extent = max_extent.max(hi - lo);
             self.key_min.push(entry_key(e));
-            self.sorted.push(Sorted {
-                proxy,
-                key_max: key_up(hi),
-                id,
-            });
+            self.keys.push(KeyBox::of(&proxy));
+            self.proxies.push(proxy);
+            self.ids.push(id);
         }
         self.key_min.push(u32::MAX);
         self.max_extent = max_extent;
@@ -157,7 +172,7 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
 
     /// The number of sorted volumes.
     pub(crate) fn len(&self) -> usize {
-        self.sorted.len()
+        self.ids.len()
     }
 
     /// Sweeps the sorted positions `range`, emitting every overlapping pair whose first
@@ -168,21 +183,19 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         balls: bool,
         emit: &mut Emitter<'_>,
     ) {
-        let axis = self.axis;
         for k in range {
-            let a = &self.sorted[k];
-            let (a_min, a_max) = (a.proxy.aabb.min(), a.proxy.aabb.max());
+            let a = &self.keys[k];
+            let a_max = a.max[self.axis];
             let mut j = k + 1;
             // The sentinel key u32::MAX exceeds every key_max, so this loop ends at the
             // last volume at the latest.
-            while self.key_min[j] <= a.key_max {
-                let b = &self.sorted[j];
-                let (b_min, b_max) = (b.proxy.aabb.min(), b.proxy.aabb.max());
-                let others = (0..D)
-                    .filter(|&d| d != axis)
-                    .all(|d| b_min[d] <= a_max[d] && a_min[d] <= b_max[d]);
-                if others && overlap(&a.proxy, &b.proxy, balls, None) {
-                    emit.push(a.id, b.id);
+            while self.key_min[j] <= a_max {
+                let b = &self.keys[j];
+                // Integer pruning on every axis (conservative), then the exact test.
+                if (0..D).all(|d| b.min[d] <= a.max[d] && a.min[d] <= b.max[d])
+                    && overlap(&self.proxies[k], &self.proxies[j], balls, None)
+                {
+                    emit.push(self.ids[k], self.ids[j]);
                 }
                 j += 1;
             }
@@ -200,8 +213,8 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         let to = key_up(hi.to_f64());
         let first = self.key_min[..n].partition_point(|&k| k < from);
         let last = self.key_min[..n].partition_point(|&k| k <= to);
-        for s in &self.sorted[first..last.max(first)] {
-            f(s.id);
+        for &id in &self.ids[first..last.max(first)] {
+            f(id);
         }
     }
 

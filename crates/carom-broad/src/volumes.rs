@@ -254,6 +254,25 @@ fn box_distance_squared<T: Real, const D: usize>(aabb: &Aabb<T, D>, p: &Vector<T
     })
 }
 
+/// The median of `value(0..n)`, estimated from at most 1025 evenly strided samples (all
+/// of them when `n <= 1025`). It only sizes cells and oversize thresholds, which affect
+/// speed, never results; being a function of the input alone, it keeps results
+/// deterministic.
+pub(crate) fn sampled_median(
+    n: usize,
+    value: impl Fn(usize) -> f64,
+    scratch: &mut Vec<f64>,
+) -> f64 {
+    scratch.clear();
+    if n == 0 {
+        return 0.0;
+    }
+    let stride = n.div_ceil(1025);
+    scratch.extend((0..n).step_by(stride).map(value));
+    let mid = scratch.len() / 2;
+    *scratch.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 /// The volumes of the current frame, in index order, with the predicate settings.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Store<T: Real, const D: usize> {

@@ -172,7 +172,7 @@ impl<T: Real, const D: usize> TestScene<T, D> {
     }
 }
 
-type Phase<T, const D: usize> = (&'static str, Box<dyn ParallelBroadPhase<T, D> + Send>);
+type Phase<T, const D: usize> = (&'static str, Box<dyn ParallelBroadPhase<T, D>>);
 
 fn phases<T: Real, const D: usize>() -> Vec<Phase<T, D>> {
     vec![
