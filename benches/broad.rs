@@ -10,9 +10,14 @@
 //! * `cargo bench --bench broad`: criterion, N = 1e3 … 1e5, uniform at packing fraction
 //!   0.1 and clustered, 2D and 3D, one-shot and coherent, 1 and 2 threads (≈ 10 min).
 //! * `CAROM_BENCH_FULL=1`: adds fraction 0.5 and N = 1e6 (long).
+//! * `CAROM_BENCH_SIZES=1000,1000000`: these ball counts instead.
+//! * `CAROM_BENCH_FILTER=3D`: table mode runs only the cases whose label
+//!   ("3D uniform0.1 1000000 coherent") contains the text.
 //! * `CAROM_BENCH_TABLE=1`: instead of criterion, prints the markdown table of
 //!   docs/broad-phase.md (median of repeated frames: ns per ball, pairs per second,
-//!   2-thread speedup) and the 10,000-random-boxes figure.
+//!   2-thread speedup) and the 10,000-random-boxes figure. Single-thread figures are
+//!   time on CPU (Linux), so that other processes on a shared machine inflate them
+//!   less; 2-thread figures are wall-clock time.
 //!
 //! parry's BVH (f32, glam) is built with `Bvh::from_leaves(Binned)` one-shot and
 //! updated with `insert_or_update_partially` + `refit` when coherent, then traversed
@@ -159,6 +164,12 @@ fn full() -> bool {
 }
 
 fn sizes() -> Vec<usize> {
+    if let Some(list) = std::env::var("CAROM_BENCH_SIZES").ok() {
+        return list
+            .split(',')
+            .filter_map(|x| x.trim().parse().ok())
+            .collect();
+    }
     if full() {
         vec![1_000, 10_000, 100_000, 1_000_000]
     } else {
@@ -178,9 +189,12 @@ fn distributions() -> Vec<Distribution> {
     }
 }
 
-/// Brute force only where it finishes in reasonable time.
+/// Brute force only where it finishes in reasonable time; `CAROM_BENCH_PHASES=sap,grid`
+/// restricts the phases.
 fn runs(name: &str, n: usize) -> bool {
-    name != "brute" || n <= 1_000
+    let chosen =
+        std::env::var("CAROM_BENCH_PHASES").map_or(true, |list| list.split(',').any(|p| p == name));
+    chosen && (name != "brute" || n <= 1_000)
 }
 
 fn pool(threads: usize) -> rayon::ThreadPool {
@@ -281,18 +295,41 @@ fn criterion_benches(c: &mut Criterion) {
 // ---------------------------------------------------------------------------------
 // table mode
 
-/// The median duration of `f` over repeated runs (at least 3, at least ~0.4 s).
-fn median_time(mut f: impl FnMut(usize)) -> Duration {
+/// The time this thread has spent on a CPU (Linux: `/proc/thread-self/schedstat`), so
+/// that single-thread figures exclude the time other processes held the cores.
+fn on_cpu() -> Option<Duration> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(Duration::from_nanos(
+        text.split_whitespace().next()?.parse().ok()?,
+    ))
+}
+
+/// The median duration of one call of `f`, over at least 5 samples (~0.5 s in all):
+/// each sample times a batch of calls lasting at least 25 ms, on CPU when `cpu` is set
+/// and the platform reports it (the per-thread clock ticks too coarsely for one short
+/// call), wall-clock otherwise.
+fn median_time(cpu: bool, mut f: impl FnMut(usize)) -> Duration {
+    let clock = || if cpu { on_cpu() } else { None };
+    let t = Instant::now();
     f(0);
     f(1);
+    let per_call = t.elapsed() / 2;
+    let batch = (Duration::from_millis(25).as_nanos() / per_call.as_nanos().max(1))
+        .clamp(1, 100_000) as usize;
     let mut times = Vec::new();
     let start = Instant::now();
     let mut k = 0;
-    while times.len() < 3 || (start.elapsed() < Duration::from_millis(400) && times.len() < 200) {
-        let t = Instant::now();
-        f(k);
-        times.push(t.elapsed());
-        k += 1;
+    while times.len() < 5 || (start.elapsed() < Duration::from_millis(500) && times.len() < 100) {
+        let (t, c) = (Instant::now(), clock());
+        for _ in 0..batch {
+            f(k);
+            k += 1;
+        }
+        let total = match (c, clock()) {
+            (Some(a), Some(b)) => b.saturating_sub(a),
+            _ => t.elapsed(),
+        };
+        times.push(total / batch as u32);
     }
     times.sort();
     times[times.len() / 2]
@@ -329,16 +366,22 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
         for &n in &sizes() {
             for coherent in [false, true] {
                 let mode = if coherent { "coherent" } else { "one-shot" };
+                let label = format!("{D}D {} {n} {mode}", dist.name());
+                if !std::env::var("CAROM_BENCH_FILTER").is_ok_and(|f| label.contains(&f))
+                    && std::env::var_os("CAROM_BENCH_FILTER").is_some()
+                {
+                    continue;
+                }
                 let frames = Frames::<D>::new(dist, n, coherent);
                 let mut out = Vec::new();
                 for name in PHASES.into_iter().filter(|p| runs(p, n)) {
                     let mut phase = make_phase::<D>(name, coherent);
                     let mut pairs = 0;
-                    let one = median_time(|k| {
+                    let one = median_time(true, |k| {
                         pairs = frame(phase.as_mut(), frames.frames[k % 2].balls(), None, &mut out)
                     });
                     let two_t = (name != "brute").then(|| {
-                        median_time(|k| {
+                        median_time(false, |k| {
                             frame(
                                 phase.as_mut(),
                                 frames.frames[k % 2].balls(),
@@ -351,7 +394,9 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
                 }
                 let mut parry = peer();
                 let mut pairs = 0;
-                let one = median_time(|k| pairs = parry.frame(&frames.frames[k % 2], coherent));
+                let one = median_time(true, |k| {
+                    pairs = parry.frame(&frames.frames[k % 2], coherent)
+                });
                 row(
                     D,
                     &dist.name(),
@@ -375,10 +420,10 @@ fn print_table() {
     let a = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 1);
     let b = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 2);
     let mut out = Vec::new();
-    for name in ["sap", "grid", "kd"] {
+    for name in ["sap", "grid", "kd"].into_iter().filter(|p| runs(p, 0)) {
         let mut phase = make_phase::<3>(name, false);
         let mut pairs = 0;
-        let one = median_time(|k| {
+        let one = median_time(true, |k| {
             pairs = frame(
                 phase.as_mut(),
                 if k % 2 == 0 { a.aabbs() } else { b.aabbs() },

@@ -10,14 +10,13 @@
 //!   twice as large (a change costs a full sort).
 //! * **Integer keys.** Bounds become order-preserving `u32` keys (see [`crate::radix`]):
 //!   the sweep compares integers, and one-shot frames sort with a three-pass radix sort.
-//! * **Sentinel.** A `u32::MAX` key after the last volume ends every sweep, so the inner
-//!   loop has one comparison and no end-of-array test of its own.
-//! * **Sorted struct-of-arrays.** The keys live in their own array (the inner loop
-//!   streams through it); the boxes, centres and indices are copied in sorted order next
-//!   to it, so a candidate's full test reads memory in sweep order, never at random.
-//! * **Integer pruning on every axis**: the keys of all `D` axes are packed per volume
-//!   in sweep order (8 bytes per axis), so most candidates are rejected by integer
-//!   compares on one small record; only survivors read the exact volume.
+//! * **Sentinel.** A `u32::MAX` key after the last volume ends every sweep at the last
+//!   volume (the scan is a slice iterator, so Rust adds no bounds checks either).
+//! * **Sorted struct-of-arrays.** The integer keys of every axis (sweep axis first,
+//!   8 bytes per axis), the exact volumes and the indices are copied into separate
+//!   arrays in sweep order: the inner loop streams through the keys alone and rejects
+//!   almost every candidate with integer compares combined into one branch; only
+//!   survivors read the exact volume, also in sweep order.
 //! * **Incremental insertion sort** for coherent frames: the previous order is re-keyed
 //!   and insertion-sorted, `O(N + swaps)`. It gives up after `4N` moves and radix-sorts
 //!   instead, so an incoherent frame costs little more than a one-shot sort.
@@ -59,8 +58,9 @@ pub enum SortKind {
     Radix,
 }
 
-/// The integer keys of a box on every axis (bounds rounded outward to `f32`): the
-/// sweep prunes on them, 8 bytes per axis, before it reads the exact volume.
+/// The integer keys of a box (bounds rounded outward to `f32`), the sweep axis first:
+/// `min[0]`/`max[0]` are on the sweep axis, `min[1..]`/`max[1..]` on the others. The
+/// sweep reads only these 8 bytes per axis until a candidate passes every axis.
 #[derive(Clone, Copy, Debug)]
 struct KeyBox<const D: usize> {
     min: [u32; D],
@@ -68,12 +68,30 @@ struct KeyBox<const D: usize> {
 }
 
 impl<const D: usize> KeyBox<D> {
-    fn of<T: Real>(proxy: &Proxy<T, D>) -> Self {
+    /// The key box of `proxy` with `axis` moved to the front.
+    fn of<T: Real>(proxy: &Proxy<T, D>, axis: usize) -> Self {
         let (lo, hi) = (proxy.aabb.min(), proxy.aabb.max());
+        // Slot 0 holds the sweep axis; slot d > 0 holds axis d − 1 or d (skipping it).
+        let axis_of = |slot: usize| match slot {
+            0 => axis,
+            s if s <= axis => s - 1,
+            s => s,
+        };
         Self {
-            min: core::array::from_fn(|d| key_down(lo[d].to_f64())),
-            max: core::array::from_fn(|d| key_up(hi[d].to_f64())),
+            min: core::array::from_fn(|s| key_down(lo[axis_of(s)].to_f64())),
+            max: core::array::from_fn(|s| key_up(hi[axis_of(s)].to_f64())),
         }
+    }
+
+    /// `true` if the boxes' keys overlap on every axis but the sweep axis. Non-short-
+    /// circuit `&`: one well-predicted branch instead of one per comparison.
+    #[inline]
+    fn overlap_off_axis(&self, other: &Self) -> bool {
+        let mut all = true;
+        for s in 1..D {
+            all &= (other.min[s] <= self.max[s]) & (self.min[s] <= other.max[s]);
+        }
+        all
     }
 }
 
@@ -88,9 +106,8 @@ pub(crate) struct SweepCore<T: Real, const D: usize> {
     entries: Vec<u64>,
     scratch: Vec<u64>,
     counts: Vec<usize>,
-    /// Sorted lower-bound keys on the sweep axis and one `u32::MAX` sentinel.
-    key_min: Vec<u32>,
-    /// In sweep order: the keys on every axis, the exact volume and its index.
+    /// In sweep order: the keys on every axis (and one sentinel), the exact volume and
+    /// its index.
     keys: Vec<KeyBox<D>>,
     proxies: Vec<Proxy<T, D>>,
     ids: Vec<u32>,
@@ -148,7 +165,6 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
                 .extend((0..n).map(|k| entry(key_of(id_at(k)), id_at(k))));
         }
 
-        self.key_min.clear();
         self.keys.clear();
         self.proxies.clear();
         self.ids.clear();
@@ -161,12 +177,16 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
                 proxy.aabb.max()[axis].to_f64(),
             );
             max_extent = max_extent.max(hi - lo);
-            self.key_min.push(entry_key(e));
-            self.keys.push(KeyBox::of(&proxy));
+            debug_assert_eq!(entry_key(e), key_down(lo));
+            self.keys.push(KeyBox::of(&proxy, axis));
             self.proxies.push(proxy);
             self.ids.push(id);
         }
-        self.key_min.push(u32::MAX);
+        // The sentinel: its lower key u32::MAX exceeds every upper key.
+        self.keys.push(KeyBox {
+            min: [u32::MAX; D],
+            max: [u32::MAX; D],
+        });
         self.max_extent = max_extent;
     }
 
@@ -184,20 +204,18 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         emit: &mut Emitter<'_>,
     ) {
         for k in range {
-            let a = &self.keys[k];
-            let a_max = a.max[self.axis];
-            let mut j = k + 1;
-            // The sentinel key u32::MAX exceeds every key_max, so this loop ends at the
-            // last volume at the latest.
-            while self.key_min[j] <= a_max {
-                let b = &self.keys[j];
-                // Integer pruning on every axis (conservative), then the exact test.
-                if (0..D).all(|d| b.min[d] <= a.max[d] && a.min[d] <= b.max[d])
-                    && overlap(&self.proxies[k], &self.proxies[j], balls, None)
+            let a = self.keys[k];
+            // Every later volume starts at or after `a` on the sweep axis, so it overlaps
+            // there exactly while its lower key is at most a's upper key. The sentinel
+            // ends the scan at the last volume; the iterator removes bounds checks.
+            for (b, j) in self.keys[k + 1..].iter().zip(k + 1..) {
+                if b.min[0] > a.max[0] {
+                    break;
+                }
+                if a.overlap_off_axis(b) && overlap(&self.proxies[k], &self.proxies[j], balls, None)
                 {
                     emit.push(self.ids[k], self.ids[j]);
                 }
-                j += 1;
             }
         }
     }
@@ -211,8 +229,8 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         let from =
             key_down(lo.to_f64() - self.max_extent * (1.0 + 4.0 * f64::EPSILON)).saturating_sub(1);
         let to = key_up(hi.to_f64());
-        let first = self.key_min[..n].partition_point(|&k| k < from);
-        let last = self.key_min[..n].partition_point(|&k| k <= to);
+        let first = self.keys[..n].partition_point(|k| k.min[0] < from);
+        let last = self.keys[..n].partition_point(|k| k.min[0] <= to);
         for &id in &self.ids[first..last.max(first)] {
             f(id);
         }
