@@ -1,7 +1,8 @@
 //! Broad-phase benchmarks: carom's sweep-and-prune, k-d tree and grids against parry's
 //! BVH, on the shared scenes of `carom_broad::scenes`.
 //!
-//! One measured frame is `update` + `pairs` (or `par_pairs` on a pool of 2 threads):
+//! One measured frame is `update` + `pairs` (or `par_update` + `par_pairs` on a pool of
+//! 2 threads):
 //! everything a stepped engine pays per step. One-shot frames alternate between two
 //! unrelated scenes; coherent frames alternate between a scene and the same scene with
 //! every ball moved by 1 % of its radius. Throughput is in balls, so criterion's
@@ -98,10 +99,15 @@ fn frame<const D: usize>(
     pool: Option<&rayon::ThreadPool>,
     out: &mut Vec<Pair>,
 ) -> usize {
-    phase.update(volumes);
     match pool {
-        None => phase.pairs(out),
-        Some(pool) => pool.install(|| phase.par_pairs(out)),
+        None => {
+            phase.update(volumes);
+            phase.pairs(out);
+        }
+        Some(pool) => pool.install(|| {
+            phase.par_update(volumes);
+            phase.par_pairs(out);
+        }),
     }
     out.len()
 }
@@ -164,7 +170,7 @@ fn full() -> bool {
 }
 
 fn sizes() -> Vec<usize> {
-    if let Some(list) = std::env::var("CAROM_BENCH_SIZES").ok() {
+    if let Ok(list) = std::env::var("CAROM_BENCH_SIZES") {
         return list
             .split(',')
             .filter_map(|x| x.trim().parse().ok())
@@ -274,7 +280,7 @@ fn bench_random_boxes(c: &mut Criterion) {
         group.bench_function(name, |bench| {
             bench.iter(|| {
                 k += 1;
-                let s = if k % 2 == 0 { &a } else { &b };
+                let s = if k.is_multiple_of(2) { &a } else { &b };
                 black_box(frame(phase.as_mut(), s.aabbs(), None, &mut out))
             });
         });
@@ -335,16 +341,9 @@ fn median_time(cpu: bool, mut f: impl FnMut(usize)) -> Duration {
     times[times.len() / 2]
 }
 
-fn row(
-    d: usize,
-    dist: &str,
-    n: usize,
-    mode: &str,
-    name: &str,
-    one: Duration,
-    two: Option<Duration>,
-    pairs: usize,
-) {
+/// Prints one table row: `case` is "dim | scene | N | frames", `one` and `two` the
+/// frame times on 1 and 2 threads.
+fn row(case: &str, n: usize, name: &str, one: Duration, two: Option<Duration>, pairs: usize) {
     let ns = one.as_secs_f64() * 1e9 / n as f64;
     let mpairs = pairs as f64 / one.as_secs_f64() / 1e6;
     let (ns2, speedup) = match two {
@@ -355,7 +354,7 @@ fn row(
         None => ("–".to_owned(), "–".to_owned()),
     };
     println!(
-        "| {d}D | {dist} | {n} | {mode} | {name} | {ns:.1} | {ns2} | {speedup} | {mpairs:.1} | {:.2} |",
+        "| {case} | {name} | {ns:.1} | {ns2} | {speedup} | {mpairs:.1} | {:.2} |",
         pairs as f64 / n as f64
     );
 }
@@ -378,7 +377,7 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
                     let mut phase = make_phase::<D>(name, coherent);
                     let mut pairs = 0;
                     let one = median_time(true, |k| {
-                        pairs = frame(phase.as_mut(), frames.frames[k % 2].balls(), None, &mut out)
+                        pairs = frame(phase.as_mut(), frames.frames[k % 2].balls(), None, &mut out);
                     });
                     let two_t = (name != "brute").then(|| {
                         median_time(false, |k| {
@@ -390,23 +389,22 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
                             );
                         })
                     });
-                    row(D, &dist.name(), n, mode, name, one, two_t, pairs);
+                    row(
+                        &format!("{D}D | {} | {n} | {mode}", dist.name()),
+                        n,
+                        name,
+                        one,
+                        two_t,
+                        pairs,
+                    );
                 }
                 let mut parry = peer();
                 let mut pairs = 0;
                 let one = median_time(true, |k| {
-                    pairs = parry.frame(&frames.frames[k % 2], coherent)
+                    pairs = parry.frame(&frames.frames[k % 2], coherent);
                 });
-                row(
-                    D,
-                    &dist.name(),
-                    n,
-                    mode,
-                    "parry-bvh (f32, box pairs)",
-                    one,
-                    None,
-                    pairs,
-                );
+                let case = format!("{D}D | {} | {n} | {mode}", dist.name());
+                row(&case, n, "parry-bvh (f32, box pairs)", one, None, pairs);
             }
         }
     }
@@ -424,18 +422,16 @@ fn print_table() {
         let mut phase = make_phase::<3>(name, false);
         let mut pairs = 0;
         let one = median_time(true, |k| {
-            pairs = frame(
-                phase.as_mut(),
-                if k % 2 == 0 { a.aabbs() } else { b.aabbs() },
-                None,
-                &mut out,
-            )
+            let boxes = if k.is_multiple_of(2) {
+                a.aabbs()
+            } else {
+                b.aabbs()
+            };
+            pairs = frame(phase.as_mut(), boxes, None, &mut out);
         });
         row(
-            3,
-            "10k random boxes",
+            "3D | 10k random boxes (Terdiman) | 10000 | one-shot",
             10_000,
-            "one-shot",
             name,
             one,
             None,

@@ -47,7 +47,7 @@ impl<T: Real, const D: usize> BruteForce<T, D> {
 
 impl<T: Real, const D: usize> BroadPhase<T, D> for BruteForce<T, D> {
     fn update(&mut self, volumes: Volumes<'_, T, D>) {
-        self.store.load(volumes);
+        self.store.load(volumes, false);
     }
 
     fn len(&self) -> usize {

@@ -32,6 +32,8 @@ use carom_geometry::{Aabb, Border};
 use carom_math::{Real, Vector};
 
 use crate::pairs::{Emitter, PairBuffers};
+use crate::par::{extend_indexed, map_in_place, max_indexed};
+use crate::radix::{entry, entry_id, entry_key, insertion_sort_bounded, radix_sort_by_key};
 use crate::sweep::{SortPolicy, SweepCore};
 use crate::volumes::{Proxy, Store, overlap, sampled_median};
 use crate::{BroadPhase, Pair, Volumes};
@@ -70,13 +72,14 @@ impl<const D: usize> Geometry<D> {
     #[inline]
     fn cell(&self, p: &[f64; D]) -> Cell<D> {
         core::array::from_fn(|k| {
-            let u = ((p[k] - self.origin[k]) * self.inv_cell[k]).floor() as i64;
+            let u = floor_to_i64((p[k] - self.origin[k]) * self.inv_cell[k]);
             if self.periodic {
                 u.rem_euclid(self.dims[k]) as i32
             } else if self.hashed {
                 u as i32
             } else {
-                u.clamp(0, self.dims[k] - 1) as i32
+                // Dense: one empty padding cell on each side.
+                (u.clamp(0, self.dims[k] - 3) + 1) as i32
             }
         })
     }
@@ -120,10 +123,12 @@ impl<const D: usize> Geometry<D> {
 
     /// The unwrapped cell-coordinate range covering `[lo, hi]` on every axis.
     fn range(&self, lo: &[f64; D], hi: &[f64; D]) -> ([i64; D], [i64; D]) {
+        let pad = i64::from(!self.periodic && !self.hashed);
         let f = |p: &[f64; D], k: usize| {
             ((p[k] - self.origin[k]) * self.inv_cell[k])
                 .floor()
                 .clamp(-4e18, 4e18) as i64
+                + pad
         };
         let mut a: [i64; D] = core::array::from_fn(|k| f(lo, k));
         let mut b: [i64; D] = core::array::from_fn(|k| f(hi, k));
@@ -138,6 +143,14 @@ impl<const D: usize> Geometry<D> {
         }
         (a, b)
     }
+}
+
+/// `⌊x⌋` as an integer (saturating), without a libm call: truncate, then step down for
+/// negative non-integers.
+#[inline]
+fn floor_to_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
 }
 
 /// The forward half of the neighbour offsets: those whose last non-zero component is
@@ -179,8 +192,14 @@ pub struct UniformGrid<T: Real, const D: usize> {
     reach: f64,
     start: Vec<u32>,
     entries: Vec<Entry<T, D>>,
-    cells: Vec<Cell<D>>,
-    buckets_of: Vec<u32>,
+    /// Sorted `(bucket, index)` keys of the regular volumes (kept for the next frame).
+    keys: Vec<u64>,
+    scratch: Vec<u64>,
+    counts: Vec<usize>,
+    /// Per volume: `true` if it is in the cells this frame.
+    in_cells: Vec<bool>,
+    /// Per volume: its bucket, or `u32::MAX` when it is not in the cells.
+    bucket_of: Vec<u32>,
     regular: Vec<u32>,
     oversized: Vec<u32>,
     oversized_sweep: SweepCore<T, D>,
@@ -204,8 +223,11 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             reach: 0.0,
             start: Vec::new(),
             entries: Vec::new(),
-            cells: Vec::new(),
-            buckets_of: Vec::new(),
+            keys: Vec::new(),
+            scratch: Vec::new(),
+            counts: Vec::new(),
+            in_cells: Vec::new(),
+            bucket_of: Vec::new(),
             regular: Vec::new(),
             oversized: Vec::new(),
             oversized_sweep: SweepCore::default(),
@@ -253,7 +275,9 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
     /// The cell counts per axis of the last update (dense and periodic layouts).
     pub fn dims(&self) -> Option<[usize; D]> {
         let g = self.geometry.as_ref().filter(|g| !g.hashed)?;
-        Some(g.dims.map(|d| d as usize))
+        // Dense grids carry one padding cell on each side.
+        let pad = if g.periodic { 0 } else { 2 };
+        Some(g.dims.map(|d| (d - pad) as usize))
     }
 
     /// Chooses the cell geometry for the regular volumes, or `None` when there is no
@@ -305,8 +329,11 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                 }
                 let span = (0..D).fold(0.0_f64, |s, k| s.max(hi[k] - lo[k]));
                 width = width.max(span / MAX_CELLS_PER_AXIS);
+                // Dense grids get an empty padding cell on each side, so that every
+                // neighbour of an occupied cell exists.
+                let pad = if hashed { 1 } else { 3 };
                 let dims_for = |w: f64| -> [i64; D] {
-                    core::array::from_fn(|k| ((hi[k] - lo[k]) / w).floor() as i64 + 1)
+                    core::array::from_fn(|k| ((hi[k] - lo[k]) / w).floor() as i64 + pad)
                 };
                 let mut dims = dims_for(width);
                 if !hashed {
@@ -383,31 +410,88 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         oversized: core::ops::Range<usize>,
         emit: &mut Emitter<'_>,
     ) {
-        let (balls, period) = (self.store.balls, self.store.period.as_ref());
-        if let Some(g) = &self.geometry {
-            for k in regular {
-                let a = &self.entries[k];
-                let end = self.start[g.bucket(&a.cell) + 1] as usize;
-                for b in &self.entries[k + 1..end] {
-                    if b.cell == a.cell && overlap(&a.proxy, &b.proxy, balls, period) {
-                        emit.push(a.id, b.id);
-                    }
+        match &self.geometry {
+            Some(g) if !g.hashed && !g.periodic => self.search_dense(g, regular, emit),
+            Some(g) => self.search_general(g, regular, emit),
+            None => {}
+        }
+        self.search_oversized(oversized, emit);
+    }
+
+    /// The regular pairs of a dense grid: thanks to the padding, the forward neighbours
+    /// of the cell with bucket `b` are the buckets `b + o` for fixed linear offsets `o`.
+    fn search_dense(
+        &self,
+        g: &Geometry<D>,
+        regular: core::ops::Range<usize>,
+        emit: &mut Emitter<'_>,
+    ) {
+        let balls = self.store.balls;
+        let mut linear = [0isize; 13];
+        for (l, offset) in linear.iter_mut().zip(&self.offsets) {
+            let mut stride = 1isize;
+            for (&o, &dim) in offset.iter().zip(&g.dims) {
+                *l += o as isize * stride;
+                stride *= dim as isize;
+            }
+        }
+        let linear = &linear[..self.offsets.len()];
+        for k in regular {
+            let a = &self.entries[k];
+            let base = entry_key(self.keys[k]) as usize;
+            for b in &self.entries[k + 1..self.start[base + 1] as usize] {
+                if overlap(&a.proxy, &b.proxy, balls, None) {
+                    emit.push(a.id, b.id);
                 }
-                for offset in &self.offsets {
-                    let Some(cell) = g.neighbour(&a.cell, offset) else {
-                        continue;
-                    };
-                    let bucket = g.bucket(&cell);
-                    for b in
-                        &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
-                    {
-                        if b.cell == cell && overlap(&a.proxy, &b.proxy, balls, period) {
-                            emit.push(a.id, b.id);
-                        }
+            }
+            for &offset in linear {
+                let bucket = base.wrapping_add_signed(offset);
+                let (from, to) = (self.start[bucket] as usize, self.start[bucket + 1] as usize);
+                for b in &self.entries[from..to] {
+                    if overlap(&a.proxy, &b.proxy, balls, None) {
+                        emit.push(a.id, b.id);
                     }
                 }
             }
         }
+    }
+
+    /// The regular pairs of a hashed or periodic grid (wrapped neighbours, colliding
+    /// cells told apart by their coordinates).
+    fn search_general(
+        &self,
+        g: &Geometry<D>,
+        regular: core::ops::Range<usize>,
+        emit: &mut Emitter<'_>,
+    ) {
+        let (balls, period) = (self.store.balls, self.store.period.as_ref());
+        for k in regular {
+            let a = &self.entries[k];
+            let end = self.start[g.bucket(&a.cell) + 1] as usize;
+            for b in &self.entries[k + 1..end] {
+                if b.cell == a.cell && overlap(&a.proxy, &b.proxy, balls, period) {
+                    emit.push(a.id, b.id);
+                }
+            }
+            for offset in &self.offsets {
+                let Some(cell) = g.neighbour(&a.cell, offset) else {
+                    continue;
+                };
+                let bucket = g.bucket(&cell);
+                for b in &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
+                {
+                    if b.cell == cell && overlap(&a.proxy, &b.proxy, balls, period) {
+                        emit.push(a.id, b.id);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The pairs of the oversized volumes at list positions `oversized`: with the
+    /// regular volumes near them, and with each other.
+    fn search_oversized(&self, oversized: core::ops::Range<usize>, emit: &mut Emitter<'_>) {
+        let (balls, period) = (self.store.balls, self.store.period.as_ref());
         for &i in &self.oversized[oversized.clone()] {
             let p = &self.store.proxies[i as usize];
             let lo = core::array::from_fn(|k| p.aabb.min()[k].to_f64() - self.reach);
@@ -471,23 +555,39 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
     }
 }
 
-impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
-    fn update(&mut self, volumes: Volumes<'_, T, D>) {
-        self.store.load(volumes);
+impl<T: Real, const D: usize> UniformGrid<T, D> {
+    /// The update, its element-wise passes on the rayon pool when `parallel`.
+    fn rebuild(&mut self, volumes: Volumes<'_, T, D>, parallel: bool) {
+        self.store.load(volumes, parallel);
         let n = self.store.len();
-
         let proxies = &self.store.proxies;
+
+        // Regular volumes (in the cells) and oversized ones.
         let threshold = self.oversize_ratio
             * sampled_median(n, |i| proxies[i].extent().to_f64(), &mut self.selection);
+        let regular = |i: usize| proxies[i].extent().to_f64() <= threshold;
+        self.in_cells.clear();
+        extend_indexed(&mut self.in_cells, n, parallel, regular);
+        let cell_width = max_indexed(n, parallel, |i| {
+            if regular(i) {
+                proxies[i].extent().to_f64()
+            } else {
+                0.0
+            }
+        });
+        let scale = max_indexed(n, parallel, |i| {
+            let p = &proxies[i];
+            if regular(i) {
+                p.center.amax().to_f64() + p.extent().to_f64()
+            } else {
+                0.0
+            }
+        });
         self.regular.clear();
         self.oversized.clear();
-        let (mut cell_width, mut scale) = (0.0_f64, 0.0_f64);
-        for (i, p) in self.store.proxies.iter().enumerate() {
-            let e = p.extent().to_f64();
-            if e <= threshold {
+        for (i, &inside) in self.in_cells.iter().enumerate() {
+            if inside {
                 self.regular.push(i as u32);
-                cell_width = cell_width.max(e);
-                scale = scale.max(p.center.amax().to_f64() + e);
             } else {
                 self.oversized.push(i as u32);
             }
@@ -497,58 +597,97 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
             self.oversized.clear();
             self.oversized.extend(0..n as u32);
             self.regular.clear();
+            self.in_cells.fill(false);
         }
         self.reach = match &self.geometry {
             Some(g) => (0..D).fold(0.0_f64, |r, k| r.max(0.5 / g.inv_cell[k])) * (1.0 + 1e-9),
             None => 0.0,
         };
 
-        // Counting sort of the regular volumes by bucket.
+        // Sort the regular volumes by bucket as (bucket, index) keys: an insertion sort
+        // from the previous frame's order when the set of regular volumes is unchanged
+        // (coherent frames: few volumes change cells), a radix sort otherwise. Both
+        // give the same order; unlike a counting sort straight into the bucket array,
+        // neither scatters at random over memory the size of the grid.
         self.entries.clear();
         self.start.clear();
-        if let Some(g) = &self.geometry {
-            self.cells.clear();
-            self.buckets_of.clear();
-            self.start.resize(g.buckets + 1, 0);
-            for &i in &self.regular {
-                let c = self.store.proxies[i as usize]
-                    .center
-                    .map(Real::to_f64)
-                    .into();
-                let cell = g.cell(&c);
-                let bucket = g.bucket(&cell);
-                self.cells.push(cell);
-                self.buckets_of.push(bucket as u32);
-                self.start[bucket + 1] += 1;
+        let Some(g) = self.geometry else {
+            self.keys.clear();
+            self.build_oversized(parallel);
+            return;
+        };
+        let proxies = &self.store.proxies;
+        let cell_of = |id: u32| g.cell(&proxies[id as usize].center.map(Real::to_f64).into());
+        // Buckets in index order, a sequential pass over the volumes, so that the
+        // re-keying in sorted order below reads 4 bytes per volume at random, not a
+        // whole volume.
+        let in_cells = &self.in_cells;
+        self.bucket_of.clear();
+        extend_indexed(&mut self.bucket_of, n, parallel, |i| {
+            if in_cells[i] {
+                g.bucket(&cell_of(i as u32)) as u32
+            } else {
+                u32::MAX
             }
-            for b in 1..=g.buckets {
-                self.start[b] += self.start[b - 1];
-            }
-            let placeholder = Entry {
-                proxy: self.store.proxies[self.regular[0] as usize],
-                cell: [0; D],
-                id: 0,
-            };
-            self.entries.resize(self.regular.len(), placeholder);
-            for (x, &i) in self.regular.iter().enumerate() {
-                let slot = &mut self.start[self.buckets_of[x] as usize];
-                self.entries[*slot as usize] = Entry {
-                    proxy: self.store.proxies[i as usize],
-                    cell: self.cells[x],
-                    id: i,
-                };
-                *slot += 1;
-            }
-            // start[b] is now the end of bucket b: shift back to starts.
-            for b in (1..=g.buckets).rev() {
-                self.start[b] = self.start[b - 1];
-            }
-            self.start[0] = 0;
+        });
+        let bucket_of = &self.bucket_of;
+        let regular = self.regular.len();
+        let same_set = self.keys.len() == regular
+            && self
+                .keys
+                .iter()
+                .all(|&e| bucket_of[entry_id(e) as usize] != u32::MAX);
+        let coherent = same_set && {
+            map_in_place(&mut self.keys, parallel, |e| {
+                entry(bucket_of[entry_id(e) as usize], entry_id(e))
+            });
+            insertion_sort_bounded(&mut self.keys, 4 * regular)
+        };
+        if !coherent {
+            self.keys.clear();
+            let ids = &self.regular;
+            extend_indexed(&mut self.keys, regular, parallel, |x| {
+                entry(bucket_of[ids[x] as usize], ids[x])
+            });
+            radix_sort_by_key(&mut self.keys, &mut self.scratch, &mut self.counts);
         }
+        // start[b] = the first sorted position whose bucket is >= b (sequential fill).
+        self.start.resize(g.buckets + 1, 0);
+        let mut b = 0;
+        for (k, &e) in self.keys.iter().enumerate() {
+            let bucket = entry_key(e) as usize;
+            self.start[b..=bucket].fill(k as u32);
+            b = bucket + 1;
+        }
+        self.start[b..].fill(regular as u32);
+        let keys = &self.keys;
+        extend_indexed(&mut self.entries, regular, parallel, |k| {
+            let id = entry_id(keys[k]);
+            Entry {
+                proxy: proxies[id as usize],
+                cell: cell_of(id),
+                id,
+            }
+        });
+        self.build_oversized(parallel);
+    }
+
+    /// Sorts the oversized volumes for their sweep (open space only).
+    fn build_oversized(&mut self, parallel: bool) {
         if self.store.period.is_none() {
-            self.oversized_sweep
-                .build(&self.store, Some(&self.oversized), SortPolicy::Radix);
+            self.oversized_sweep.build(
+                &self.store,
+                Some(&self.oversized),
+                SortPolicy::Radix,
+                parallel,
+            );
         }
+    }
+}
+
+impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
+    fn update(&mut self, volumes: Volumes<'_, T, D>) {
+        self.rebuild(volumes, false);
     }
 
     fn len(&self) -> usize {
@@ -594,6 +733,10 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
 
 #[cfg(feature = "parallel")]
 impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for UniformGrid<T, D> {
+    fn par_update(&mut self, volumes: Volumes<'_, T, D>) {
+        self.rebuild(volumes, true);
+    }
+
     fn par_pairs(&mut self, out: &mut Vec<Pair>) {
         use rayon::prelude::*;
         let (n, r, m) = (self.store.len(), self.entries.len(), self.oversized.len());

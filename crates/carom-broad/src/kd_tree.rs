@@ -171,7 +171,7 @@ impl<T: Real, const D: usize> KdTree<T, D> {
 
 impl<T: Real, const D: usize> BroadPhase<T, D> for KdTree<T, D> {
     fn update(&mut self, volumes: Volumes<'_, T, D>) {
-        self.store.load(volumes);
+        self.store.load(volumes, false);
         let proxies = &self.store.proxies;
         let n = proxies.len();
 
@@ -213,7 +213,7 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for KdTree<T, D> {
             self.oversized.extend(0..n as u32);
         }
         self.oversized_sweep
-            .build(&self.store, Some(&self.oversized), SortPolicy::Radix);
+            .build(&self.store, Some(&self.oversized), SortPolicy::Radix, false);
     }
 
     fn len(&self) -> usize {

@@ -42,6 +42,7 @@ mod brute_force;
 mod grid;
 mod kd_tree;
 mod pairs;
+mod par;
 mod radix;
 pub mod scenes;
 mod sweep;
@@ -88,6 +89,12 @@ pub trait BroadPhase<T: Real, const D: usize> {
 /// A broad phase whose pair finding runs in parallel with rayon.
 #[cfg(feature = "parallel")]
 pub trait ParallelBroadPhase<T: Real, const D: usize>: BroadPhase<T, D> + Send {
+    /// [`BroadPhase::update`] with its data-parallel passes on the current rayon thread
+    /// pool; the broad phase ends in the same state (the default runs `update`).
+    fn par_update(&mut self, volumes: Volumes<'_, T, D>) {
+        self.update(volumes);
+    }
+
     /// [`BroadPhase::pairs`] on the current rayon thread pool; the result is identical.
     fn par_pairs(&mut self, out: &mut Vec<Pair>);
 }

@@ -28,6 +28,7 @@ use carom_geometry::Aabb;
 use carom_math::{Real, Vector};
 
 use crate::pairs::{Emitter, PairBuffers};
+use crate::par::{extend_indexed, map_in_place, max_indexed};
 use crate::radix::{
     entry, entry_id, entry_key, insertion_sort_bounded, key_down, key_up, radix_sort_by_key,
 };
@@ -86,6 +87,7 @@ impl<const D: usize> KeyBox<D> {
     /// `true` if the boxes' keys overlap on every axis but the sweep axis. Non-short-
     /// circuit `&`: one well-predicted branch instead of one per comparison.
     #[inline]
+    #[allow(clippy::needless_bitwise_bool)] // deliberate, see above
     fn overlap_off_axis(&self, other: &Self) -> bool {
         let mut all = true;
         for s in 1..D {
@@ -116,7 +118,13 @@ pub(crate) struct SweepCore<T: Real, const D: usize> {
 
 impl<T: Real, const D: usize> SweepCore<T, D> {
     /// Sorts the volumes `ids` of `store` (all of them when `ids` is `None`).
-    pub(crate) fn build(&mut self, store: &Store<T, D>, ids: Option<&[u32]>, policy: SortPolicy) {
+    pub(crate) fn build(
+        &mut self,
+        store: &Store<T, D>,
+        ids: Option<&[u32]>,
+        policy: SortPolicy,
+        parallel: bool,
+    ) {
         // A subset's members change between frames: its previous order means nothing.
         let policy = if ids.is_some() {
             SortPolicy::Radix
@@ -142,20 +150,18 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         self.last_sort = SortKind::None;
         if n >= 2 {
             let coherent = keep_axis && {
-                for e in &mut self.entries {
-                    let id = entry_id(*e);
-                    *e = entry(key_of(id), id);
-                }
+                map_in_place(&mut self.entries, parallel, |e| {
+                    entry(key_of(entry_id(e)), entry_id(e))
+                });
                 insertion_sort_bounded(&mut self.entries, 4 * n)
             };
             if coherent {
                 self.last_sort = SortKind::Insertion;
             } else {
                 self.entries.clear();
-                self.entries.extend((0..n).map(|k| {
-                    let id = id_at(k);
-                    entry(key_of(id), id)
-                }));
+                extend_indexed(&mut self.entries, n, parallel, |k| {
+                    entry(key_of(id_at(k)), id_at(k))
+                });
                 radix_sort_by_key(&mut self.entries, &mut self.scratch, &mut self.counts);
                 self.last_sort = SortKind::Radix;
             }
@@ -165,29 +171,29 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
                 .extend((0..n).map(|k| entry(key_of(id_at(k)), id_at(k))));
         }
 
-        self.keys.clear();
+        // Gather in sweep order: the exact volumes, their keys, their indices.
+        let entries = &self.entries;
         self.proxies.clear();
+        extend_indexed(&mut self.proxies, n, parallel, |k| {
+            proxies[entry_id(entries[k]) as usize]
+        });
+        let sorted = &self.proxies;
+        self.keys.clear();
+        extend_indexed(&mut self.keys, n, parallel, |k| {
+            KeyBox::of(&sorted[k], axis)
+        });
         self.ids.clear();
-        let mut max_extent = 0.0_f64;
-        for &e in &self.entries {
-            let id = entry_id(e);
-            let proxy = proxies[id as usize];
-            let (lo, hi) = (
-                proxy.aabb.min()[axis].to_f64(),
-                proxy.aabb.max()[axis].to_f64(),
-            );
-            max_extent = max_extent.max(hi - lo);
-            debug_assert_eq!(entry_key(e), key_down(lo));
-            self.keys.push(KeyBox::of(&proxy, axis));
-            self.proxies.push(proxy);
-            self.ids.push(id);
-        }
+        extend_indexed(&mut self.ids, n, parallel, |k| entry_id(entries[k]));
+        debug_assert!((0..n).all(|k| self.keys[k].min[0] == entry_key(entries[k])));
+        self.max_extent = max_indexed(n, parallel, |k| {
+            let aabb = &sorted[k].aabb;
+            aabb.max()[axis].to_f64() - aabb.min()[axis].to_f64()
+        });
         // The sentinel: its lower key u32::MAX exceeds every upper key.
         self.keys.push(KeyBox {
             min: [u32::MAX; D],
             max: [u32::MAX; D],
         });
-        self.max_extent = max_extent;
     }
 
     /// The number of sorted volumes.
@@ -242,9 +248,10 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
     }
 }
 
-/// The per-axis variance of the box centres, and the axis where it is largest.
-/// Centres are shifted by the first one before summing, so coordinates far from the
-/// origin (`1e6`) do not cancel the spread away.
+/// The per-axis variance of the box centres (of at most 4096 evenly strided ones: the
+/// axis only affects speed), and the axis where it is largest. Centres are shifted by
+/// the first one before summing, so coordinates far from the origin (`1e6`) do not
+/// cancel the spread away.
 fn axis_variances<'p, T: Real + 'p, const D: usize>(
     n: usize,
     proxy: impl Fn(usize) -> &'p Proxy<T, D>,
@@ -256,7 +263,9 @@ fn axis_variances<'p, T: Real + 'p, const D: usize>(
     let origin = proxy(0).center;
     let mut sum = [0.0_f64; D];
     let mut sum_sq = [0.0_f64; D];
-    for k in 0..n {
+    let stride = n.div_ceil(4096);
+    let samples = n.div_ceil(stride);
+    for k in (0..n).step_by(stride) {
         let c = proxy(k).center;
         for d in 0..D {
             let x = (c[d] - origin[d]).to_f64();
@@ -264,7 +273,7 @@ fn axis_variances<'p, T: Real + 'p, const D: usize>(
             sum_sq[d] += x * x;
         }
     }
-    let inv = 1.0 / n as f64;
+    let inv = 1.0 / samples as f64;
     for d in 0..D {
         let mean = sum[d] * inv;
         variances[d] = (sum_sq[d] * inv - mean * mean).max(0.0);
@@ -321,8 +330,8 @@ impl<T: Real, const D: usize> SweepAndPrune<T, D> {
 
 impl<T: Real, const D: usize> BroadPhase<T, D> for SweepAndPrune<T, D> {
     fn update(&mut self, volumes: Volumes<'_, T, D>) {
-        self.store.load(volumes);
-        self.core.build(&self.store, None, self.policy);
+        self.store.load(volumes, false);
+        self.core.build(&self.store, None, self.policy, false);
     }
 
     fn len(&self) -> usize {
@@ -356,6 +365,11 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for SweepAndPrune<T, D> {
 
 #[cfg(feature = "parallel")]
 impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for SweepAndPrune<T, D> {
+    fn par_update(&mut self, volumes: Volumes<'_, T, D>) {
+        self.store.load(volumes, true);
+        self.core.build(&self.store, None, self.policy, true);
+    }
+
     fn par_pairs(&mut self, out: &mut Vec<Pair>) {
         use rayon::prelude::*;
         let n = self.store.len();

@@ -26,6 +26,8 @@
 use carom_geometry::{Aabb, Border, BoundingVolume};
 use carom_math::{InvalidValue, Problem, Real, Vector, ensure_finite_vector, ensure_non_negative};
 
+use crate::par::extend_indexed;
+
 /// Bounding volumes for one update: boxes or balls.
 #[derive(Clone, Copy, Debug)]
 pub enum Volumes<'a, T: Real, const D: usize> {
@@ -285,21 +287,20 @@ pub(crate) struct Store<T: Real, const D: usize> {
 
 impl<T: Real, const D: usize> Store<T, D> {
     /// Copies the volumes in (reusing the buffer).
-    pub(crate) fn load(&mut self, volumes: Volumes<'_, T, D>) {
+    pub(crate) fn load(&mut self, volumes: Volumes<'_, T, D>, parallel: bool) {
         self.proxies.clear();
         match volumes {
             Volumes::Boxes(boxes) => {
                 self.balls = false;
-                self.proxies.extend(boxes.iter().map(Proxy::from_box));
+                extend_indexed(&mut self.proxies, boxes.len(), parallel, |i| {
+                    Proxy::from_box(&boxes[i])
+                });
             }
             Volumes::Balls(b) => {
                 self.balls = true;
-                self.proxies.extend(
-                    b.centers
-                        .iter()
-                        .zip(b.radii)
-                        .map(|(c, &r)| Proxy::from_ball(c, r + b.margin)),
-                );
+                extend_indexed(&mut self.proxies, b.len(), parallel, |i| {
+                    Proxy::from_ball(&b.centers[i], b.radii[i] + b.margin)
+                });
             }
         }
     }

@@ -357,6 +357,15 @@ fn check_parallel<T: Real, const D: usize>(kind: Kind, n: usize, seed: u64) {
                     let mut par = vec![(7, 7)]; // stale content must be replaced
                     on_threads(threads, || phase.par_pairs(&mut par));
                     assert_eq!(par, seq, "{name}, frame {frame}, {threads} threads");
+                    // A parallel update leaves the same state: same pairs, same queries.
+                    on_threads(threads, || {
+                        phase.par_update(volumes);
+                        phase.par_pairs(&mut par);
+                    });
+                    assert_eq!(
+                        par, seq,
+                        "{name}, frame {frame}, {threads} threads, par_update"
+                    );
                 }
             }
         }
@@ -418,5 +427,50 @@ fn box_input_equals_bounding_volume_intersects() {
         phase.update(Volumes::boxes(&boxes).unwrap());
         phase.pairs(&mut got);
         assert_eq!(got, expected, "{name}");
+    }
+}
+
+#[test]
+fn parallel_updates_of_large_scenes_leave_identical_state() {
+    // Above the size where the update passes go parallel (8192 volumes).
+    use carom_broad::scenes::Scene;
+    for mut scene in [
+        Scene::<f64, 3>::uniform(20_000, 0.5, 0.2, 0.0, 5),
+        Scene::<f64, 3>::clustered(20_000, 0.5, 0.1, 7, 6),
+        Scene::<f64, 3>::mixed(12_000, 1e-3, 1.0, 0.2, 8),
+    ] {
+        let mut sequential = phases::<f64, 3>();
+        let mut parallel = phases::<f64, 3>();
+        let mut oracle_pairs = None;
+        for frame in 0..3 {
+            for ((name, seq), (_, par)) in sequential.iter_mut().zip(&mut parallel) {
+                let (mut a, mut b) = (Vec::new(), Vec::new());
+                seq.update(scene.balls());
+                seq.pairs(&mut a);
+                on_threads(2, || {
+                    par.par_update(scene.balls());
+                    par.par_pairs(&mut b);
+                });
+                assert_eq!(a, b, "{name}, frame {frame}");
+                // Every phase agrees with the first one (itself checked against brute
+                // force on the first frame).
+                let expected = oracle_pairs.get_or_insert_with(|| {
+                    let mut brute = BruteForce::new();
+                    brute.update(scene.balls());
+                    let mut e = Vec::new();
+                    brute.pairs(&mut e);
+                    e
+                });
+                assert_eq!(&a, expected, "{name}, frame {frame}");
+                let (mut qa, mut qb) = (Vec::new(), Vec::new());
+                for i in (0..scene.len()).step_by(997) {
+                    seq.query_ball(&scene.centers[i], 1.5, &mut qa);
+                    par.query_ball(&scene.centers[i], 1.5, &mut qb);
+                    assert_eq!(qa, qb, "{name}: queries after a parallel update");
+                }
+            }
+            scene.step(0.01);
+            oracle_pairs = None;
+        }
     }
 }
