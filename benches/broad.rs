@@ -311,7 +311,8 @@ fn on_cpu() -> Option<Duration> {
 }
 
 /// The median duration of one call of `f`, over at least 5 samples (~0.5 s in all):
-/// each sample times a batch of calls lasting at least 25 ms, on CPU when `cpu` is set
+/// each sample times a batch of calls lasting at least 25 ms (120 ms on the per-thread CPU
+/// clock, which ticks in steps of a few ms on some kernels), on CPU when `cpu` is set
 /// and the platform reports it (the per-thread clock ticks too coarsely for one short
 /// call), wall-clock otherwise.
 fn median_time(cpu: bool, mut f: impl FnMut(usize)) -> Duration {
@@ -320,8 +321,12 @@ fn median_time(cpu: bool, mut f: impl FnMut(usize)) -> Duration {
     f(0);
     f(1);
     let per_call = t.elapsed() / 2;
-    let batch = (Duration::from_millis(25).as_nanos() / per_call.as_nanos().max(1))
-        .clamp(1, 100_000) as usize;
+    let target = if cpu {
+        Duration::from_millis(120)
+    } else {
+        Duration::from_millis(25)
+    };
+    let batch = (target.as_nanos() / per_call.as_nanos().max(1)).clamp(1, 100_000) as usize;
     let mut times = Vec::new();
     let start = Instant::now();
     let mut k = 0;

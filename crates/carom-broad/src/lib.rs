@@ -15,6 +15,32 @@
 //!
 //! `docs/broad-phase.md` has the measured table and a guide to picking one.
 //!
+//! ```
+//! use carom_broad::{Balls, BroadPhase, NeighbourLists, UniformGrid, Vector};
+//!
+//! // A stepped engine's struct-of-arrays state, fed as is.
+//! let centers = [Vector::<f64, 2>::new(0.0, 0.0), Vector::new(1.5, 0.0), Vector::new(5.0, 5.0)];
+//! let radii = [1.0, 1.0, 0.5];
+//! let mut grid = UniformGrid::dense();
+//! let mut pairs = Vec::new(); // reused frame after frame
+//! grid.update(Balls::new(&centers, &radii)?.into());
+//! grid.pairs(&mut pairs);
+//! assert_eq!(pairs, [(0, 1)]);
+//!
+//! // Neighbour lists with a shell of 2.0: |c_i - c_j| <= r_i + r_j + 2.
+//! grid.update(Balls::new(&centers, &radii)?.with_margin(1.0)?.into());
+//! grid.pairs(&mut pairs);
+//! let mut lists = NeighbourLists::new();
+//! lists.rebuild(centers.len(), &pairs);
+//! assert_eq!(lists.of(0), &[1]);
+//!
+//! // Everything within 4.0 of the origin, counting the balls' radii.
+//! let mut hits = Vec::new();
+//! grid.query_ball(&Vector::new(0.0, 0.0), 4.0, &mut hits);
+//! assert_eq!(hits, [0, 1]);
+//! # Ok::<(), carom_broad::InvalidValue>(())
+//! ```
+//!
 //! # Guarantees
 //!
 //! * **Exact.** Every implementation returns exactly the pairs the shared predicate
