@@ -10,7 +10,9 @@
 //!
 //! * `cargo bench --bench broad`: criterion, N = 1e3 … 1e5, uniform at packing fraction
 //!   0.1 and clustered, 2D and 3D, one-shot and coherent, 1 and 2 threads (≈ 10 min).
-//! * `CAROM_BENCH_FULL=1`: adds fraction 0.5 and N = 1e6 (long).
+//! * `CAROM_BENCH_FULL=1`: adds fraction 0.5, radii log-uniform in `[1e-3, 1]` and
+//!   N = 1e6 (long: sweep-and-prune needs seconds per frame at 1e6 in 3D).
+//! * `CAROM_BENCH_DISTS=uniform0.1,uniform0.5,clustered,mixed`: these scenes instead.
 //! * `CAROM_BENCH_SIZES=1000,1000000`: these ball counts instead.
 //! * `CAROM_BENCH_FILTER=3D`: table mode runs only the cases whose label
 //!   ("3D uniform0.1 1000000 coherent") contains the text.
@@ -41,6 +43,8 @@ enum Distribution {
     Uniform(f64),
     /// 16 clumps, packing fraction 0.1 over the whole domain.
     Clustered,
+    /// Radii log-uniform in [1e-3, 1], uniform at packing fraction 0.1.
+    Mixed,
 }
 
 impl Distribution {
@@ -48,6 +52,7 @@ impl Distribution {
         match self {
             Self::Uniform(f) => format!("uniform{f}"),
             Self::Clustered => "clustered".to_owned(),
+            Self::Mixed => "mixed-radii".to_owned(),
         }
     }
 
@@ -55,6 +60,7 @@ impl Distribution {
         match self {
             Self::Uniform(f) => Scene::uniform(n, 0.5, f, 0.0, seed),
             Self::Clustered => Scene::clustered(n, 0.5, 0.1, 16, seed),
+            Self::Mixed => Scene::mixed(n, 1e-3, 1.0, 0.1, seed),
         }
     }
 }
@@ -184,11 +190,24 @@ fn sizes() -> Vec<usize> {
 }
 
 fn distributions() -> Vec<Distribution> {
+    if let Ok(list) = std::env::var("CAROM_BENCH_DISTS") {
+        return list
+            .split(',')
+            .filter_map(|d| match d.trim() {
+                "uniform0.1" => Some(Distribution::Uniform(0.1)),
+                "uniform0.5" => Some(Distribution::Uniform(0.5)),
+                "clustered" => Some(Distribution::Clustered),
+                "mixed" => Some(Distribution::Mixed),
+                _ => None,
+            })
+            .collect();
+    }
     if full() {
         vec![
             Distribution::Uniform(0.1),
             Distribution::Uniform(0.5),
             Distribution::Clustered,
+            Distribution::Mixed,
         ]
     } else {
         vec![Distribution::Uniform(0.1), Distribution::Clustered]
@@ -380,9 +399,8 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
                 let mut out = Vec::new();
                 for name in PHASES.into_iter().filter(|p| runs(p, n)) {
                     let mut phase = make_phase::<D>(name, coherent);
-                    let mut pairs = 0;
                     let one = median_time(true, |k| {
-                        pairs = frame(phase.as_mut(), frames.frames[k % 2].balls(), None, &mut out);
+                        frame(phase.as_mut(), frames.frames[k % 2].balls(), None, &mut out);
                     });
                     let two_t = (name != "brute").then(|| {
                         median_time(false, |k| {
@@ -394,6 +412,7 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
                             );
                         })
                     });
+                    let pairs = frame(phase.as_mut(), frames.frames[0].balls(), None, &mut out);
                     row(
                         &format!("{D}D | {} | {n} | {mode}", dist.name()),
                         n,
@@ -404,10 +423,11 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
                     );
                 }
                 let mut parry = peer();
-                let mut pairs = 0;
                 let one = median_time(true, |k| {
-                    pairs = parry.frame(&frames.frames[k % 2], coherent);
+                    parry.frame(&frames.frames[k % 2], coherent);
                 });
+                // The pair column is always the first frame's.
+                let pairs = parry.frame(&frames.frames[0], coherent);
                 let case = format!("{D}D | {} | {n} | {mode}", dist.name());
                 row(&case, n, "parry-bvh (f32, box pairs)", one, None, pairs);
             }
@@ -425,15 +445,15 @@ fn print_table() {
     let mut out = Vec::new();
     for name in ["sap", "grid", "kd"].into_iter().filter(|p| runs(p, 0)) {
         let mut phase = make_phase::<3>(name, false);
-        let mut pairs = 0;
         let one = median_time(true, |k| {
             let boxes = if k.is_multiple_of(2) {
                 a.aabbs()
             } else {
                 b.aabbs()
             };
-            pairs = frame(phase.as_mut(), boxes, None, &mut out);
+            frame(phase.as_mut(), boxes, None, &mut out);
         });
+        let pairs = frame(phase.as_mut(), a.aabbs(), None, &mut out);
         row(
             "3D | 10k random boxes (Terdiman) | 10000 | one-shot",
             10_000,

@@ -35,7 +35,7 @@ use crate::pairs::{Emitter, PairBuffers};
 use crate::par::{extend_indexed, map_in_place, max_indexed};
 use crate::radix::{entry, entry_id, entry_key, insertion_sort_bounded, radix_sort_by_key};
 use crate::sweep::{SortPolicy, SweepCore};
-use crate::volumes::{Proxy, Store, overlap, sampled_median};
+use crate::volumes::{Proxy, Store, ensure_ratio, overlap, sampled_median};
 use crate::{BroadPhase, Pair, Volumes};
 
 /// How a [`UniformGrid`] lays its cells out.
@@ -257,8 +257,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
     /// # Errors
     /// `ratio` if it is NaN or below 1.
     pub fn with_oversize_ratio(mut self, ratio: f64) -> Result<Self, carom_math::InvalidValue> {
-        carom_math::ensure_in_range("ratio", ratio.min(f64::MAX), 1.0, f64::MAX)?;
-        self.oversize_ratio = ratio;
+        self.oversize_ratio = ensure_ratio(ratio)?;
         Ok(self)
     }
 

@@ -39,7 +39,7 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use crate::pairs::{Emitter, PairBuffers};
 use crate::sweep::{SortPolicy, SweepCore};
-use crate::volumes::{Store, sampled_median};
+use crate::volumes::{Store, ensure_ratio, sampled_median};
 use crate::{BroadPhase, Pair, Volumes};
 
 /// A k-d tree broad phase over boxes or balls, in open space.
@@ -90,12 +90,9 @@ impl<T: Real, const D: usize> KdTree<T, D> {
     ///
     /// # Errors
     /// `ratio` if it is NaN or below 1.
-    pub fn with_oversize_ratio(ratio: f64) -> Result<Self, carom_math::InvalidValue> {
-        carom_math::ensure_in_range("ratio", ratio.min(f64::MAX), 1.0, f64::MAX)?;
-        Ok(Self {
-            oversize_ratio: ratio,
-            ..Self::new()
-        })
+    pub fn with_oversize_ratio(mut self, ratio: f64) -> Result<Self, carom_math::InvalidValue> {
+        self.oversize_ratio = ensure_ratio(ratio)?;
+        Ok(self)
     }
 
     /// How many volumes the last update kept out of the tree.

@@ -19,7 +19,8 @@
 //! use carom_broad::{Balls, BroadPhase, NeighbourLists, UniformGrid, Vector};
 //!
 //! // A stepped engine's struct-of-arrays state, fed as is.
-//! let centers = [Vector::<f64, 2>::new(0.0, 0.0), Vector::new(1.5, 0.0), Vector::new(5.0, 5.0)];
+//! type V = Vector<f64, 2>;
+//! let centers = [V::new(0.0, 0.0), V::new(1.5, 0.0), V::new(5.0, 5.0)];
 //! let radii = [1.0, 1.0, 0.5];
 //! let mut grid = UniformGrid::dense();
 //! let mut pairs = Vec::new(); // reused frame after frame
@@ -36,7 +37,7 @@
 //!
 //! // Everything within 4.0 of the origin, counting the balls' radii.
 //! let mut hits = Vec::new();
-//! grid.query_ball(&Vector::new(0.0, 0.0), 4.0, &mut hits);
+//! grid.query_ball(&V::new(0.0, 0.0), 4.0, &mut hits);
 //! assert_eq!(hits, [0, 1]);
 //! # Ok::<(), carom_broad::InvalidValue>(())
 //! ```

@@ -147,6 +147,23 @@ impl<'a, T: Real, const D: usize> Balls<'a, T, D> {
     }
 }
 
+/// `Ok(ratio)` for an oversize ratio `>= 1` (`+inf` allowed: nothing is oversized).
+pub(crate) fn ensure_ratio(ratio: f64) -> Result<f64, InvalidValue> {
+    // Written so that NaN fails too.
+    if ratio >= 1.0 {
+        Ok(ratio)
+    } else {
+        Err(InvalidValue::new(
+            "ratio",
+            Problem::OutOfRange {
+                value: ratio,
+                min: 1.0,
+                max: f64::INFINITY,
+            },
+        ))
+    }
+}
+
 fn ensure_u32_count(field: &'static str, n: usize) -> Result<(), InvalidValue> {
     if u32::try_from(n).is_ok() {
         Ok(())
@@ -394,6 +411,14 @@ mod tests {
         assert_eq!(Balls::new(&c, &[1.0, 2.0]).unwrap_err().field, "radii");
         let b = Balls::new(&c, &[1.0]).unwrap();
         assert_eq!(b.with_margin(-0.5).unwrap_err().field, "margin");
+    }
+
+    #[test]
+    fn oversize_ratios_below_one_and_nan_are_rejected() {
+        assert_eq!(ensure_ratio(f64::INFINITY), Ok(f64::INFINITY));
+        assert_eq!(ensure_ratio(1.0), Ok(1.0));
+        assert!(ensure_ratio(f64::NAN).is_err());
+        assert_eq!(ensure_ratio(0.5).unwrap_err().field, "ratio");
     }
 
     #[test]

@@ -184,7 +184,11 @@ fn phases<T: Real, const D: usize>() -> Vec<Phase<T, D>> {
         ("kd", Box::new(KdTree::new())),
         (
             "kd no oversize",
-            Box::new(KdTree::with_oversize_ratio(f64::INFINITY).unwrap()),
+            Box::new(KdTree::new().with_oversize_ratio(f64::INFINITY).unwrap()),
+        ),
+        (
+            "kd ratio 1",
+            Box::new(KdTree::new().with_oversize_ratio(1.0).unwrap()),
         ),
         ("grid dense", Box::new(UniformGrid::dense())),
         (
