@@ -60,12 +60,20 @@ const BUCKETS: usize = 1 << RADIX_BITS;
 
 /// Stable LSD radix sort of `entries` by their key (the high 32 bits), in three passes
 /// of 11 bits; a pass whose digits are all equal is skipped (Terdiman's check). If the
-/// entries were in index order, the result is sorted by `(key, index)`.
+/// entries were in index order, the result is sorted by `(key, index)`. Short inputs
+/// are sorted by comparison instead, with the same result.
 pub(crate) fn radix_sort_by_key(
     entries: &mut Vec<u64>,
     scratch: &mut Vec<u64>,
     counts: &mut Vec<usize>,
 ) {
+    // Below a few hundred entries the passes over 2048 buckets cost more than a
+    // comparison sort of the whole entries, which gives the same (key, index) order
+    // when the input is in index order.
+    if entries.len() < 256 {
+        entries.sort_unstable();
+        return;
+    }
     scratch.clear();
     scratch.resize(entries.len(), 0);
     counts.clear();
