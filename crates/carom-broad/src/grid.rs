@@ -7,18 +7,23 @@
 //! (4 in 2D, 13 in 3D): every neighbouring cell pair is visited once.
 //!
 //! * **Cell size.** `oversize_ratio × median` (default 2) of the volumes' largest edge
-//!   lengths (the median estimated from at most 1025 strided samples) separates regular volumes from oversized ones; the cell is the largest
-//!   regular edge, grown by `2^-10` relative and `16 ε_T · scale` absolute so that no
-//!   rounding can put two touching volumes two cells apart, even at `1e6` from the
-//!   origin. Volumes are sorted into cells by a counting sort (one pass to count, one to
-//!   place, no per-cell `Vec`).
+//!   lengths (the median estimated from at most 1025 strided samples) separates regular
+//!   volumes from oversized ones; the cell is the largest regular edge, grown by `2^-10`
+//!   relative and `16 ε_T · scale` absolute so that no rounding can put two touching
+//!   volumes two cells apart, even at `1e6` from the origin.
+//! * **Bucketing.** `(bucket, index)` keys are radix-sorted, or insertion-sorted from the
+//!   previous frame's order when the frame is coherent; `start[bucket]` is then filled
+//!   in one sequential pass and the volumes are gathered in bucket order. No per-cell
+//!   `Vec`, and no random scatter over an array the size of the grid.
 //! * **Oversized volumes** stay out of the cells. Each one is tested against the regular
 //!   volumes of the cells its box (grown by half a cell) covers, or against all of them
 //!   when that is fewer; oversized volumes meet each other in a sweep-and-prune (in a
-//!   periodic domain, by brute force). With very mixed sizes that list grows, and
-//!   [`SweepAndPrune`](crate::SweepAndPrune) is the better choice.
+//!   periodic domain, by brute force). With very mixed sizes that list grows and each
+//!   big volume walks many small cells: the k-d tree or the sweep is then the better
+//!   choice (docs/broad-phase.md has the measurements).
 //! * **Layouts.** [`GridLayout::Dense`] spans the bounding box of this frame's centres
-//!   with at most `8N + 64` cells (the cell grows if the scene is sparse);
+//!   with at most `8N + 64` cells (the cell grows if the scene is sparse), plus one
+//!   empty padding cell on each side so that neighbours are fixed linear offsets;
 //!   [`GridLayout::Hashed`] hashes integer cell coordinates into a table of about `2N`
 //!   buckets, for unbounded or sparse worlds (a bucket can hold several cells, so each
 //!   entry keeps its cell coordinates and only entries of the wanted cell are tested);
