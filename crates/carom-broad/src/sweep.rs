@@ -102,7 +102,6 @@ impl<const D: usize> KeyBox<D> {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SweepCore<T: Real, const D: usize> {
     axis: usize,
-    axis_variance: f64,
     /// The largest box extent on the sweep axis (for queries).
     max_extent: f64,
     entries: Vec<u64>,
@@ -143,7 +142,6 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         if !keep_axis {
             self.axis = best_axis;
         }
-        self.axis_variance = variances[self.axis];
         let axis = self.axis;
         let key_of = |id: u32| key_down(proxies[id as usize].aabb.min()[axis].to_f64());
 

@@ -478,3 +478,43 @@ fn parallel_updates_of_large_scenes_leave_identical_state() {
         }
     }
 }
+
+#[test]
+fn extreme_finite_inputs_neither_panic_nor_lose_pairs() {
+    // Coordinates and sizes near the top of the f64 range: boxes spanning everything
+    // (their extents overflow to infinity), balls at 1e300 with radius 1e300, points.
+    let big = f64::MAX / 2.0;
+    let boxes = vec![
+        Aabb::new(Vector::<f64, 3>::repeat(-big), Vector::repeat(big)).unwrap(),
+        Aabb::new(Vector::repeat(-f64::MAX), Vector::repeat(f64::MAX)).unwrap(),
+        Aabb::new(Vector::repeat(1.0), Vector::repeat(1.0)).unwrap(),
+        Aabb::new(Vector::repeat(1e300), Vector::repeat(1e300)).unwrap(),
+        Aabb::new(Vector::repeat(-1e-300), Vector::repeat(1e-300)).unwrap(),
+    ];
+    let centers: Vec<Vector<f64, 3>> = vec![
+        Vector::repeat(1e300),
+        Vector::repeat(-1e300),
+        Vector::repeat(0.0),
+        Vector::repeat(1e-300),
+        Vector::<f64, 3>::new(1e300, -1e300, 0.0),
+    ];
+    let radii = vec![1e300, 1e300, 0.0, 1e-300, 5e299];
+    let mut oracle = BruteForce::new();
+    let queries = [(Vector::repeat(0.0), 1.0), (Vector::repeat(1e300), 1e299)];
+    for (name, mut phase) in phases::<f64, 3>() {
+        assert_matches_oracle(
+            name,
+            phase.as_mut(),
+            &mut oracle,
+            Volumes::boxes(&boxes).unwrap(),
+            &queries,
+        );
+        assert_matches_oracle(
+            name,
+            phase.as_mut(),
+            &mut oracle,
+            Balls::new(&centers, &radii).unwrap().into(),
+            &queries,
+        );
+    }
+}
