@@ -15,12 +15,16 @@
 //!   previous frame's order when the frame is coherent; `start[bucket]` is then filled
 //!   in one sequential pass and the volumes are gathered in bucket order. No per-cell
 //!   `Vec`, and no random scatter over an array the size of the grid.
-//! * **Oversized volumes** stay out of the cells. Each one is tested against the regular
-//!   volumes of the cells its box (grown by half a cell) covers, or against all of them
-//!   when that is fewer; oversized volumes meet each other in a sweep-and-prune (in a
-//!   periodic domain, by brute force). With very mixed sizes that list grows and each
-//!   big volume walks many small cells: the k-d tree or the sweep is then the better
-//!   choice (docs/broad-phase.md has the measurements).
+//! * **Oversized volumes** stay out of the cells. From 32 of them on they form a coarser
+//!   level: a grid of the same layout over just them, with its own median and cell size
+//!   (and, recursively, its own coarser level; each level at least halves the count, so
+//!   radii over many decades make a few levels, not a deep tree). A volume of a finer
+//!   level is smaller than every volume of a coarser one and the coarser cells are as
+//!   wide as their largest volume, so it finds its coarser partners in the `3^D` cells
+//!   around its centre's cell on each coarser level. Fewer than 32 oversized volumes are
+//!   instead tested against the regular volumes of the cells their box (grown by half a
+//!   cell) covers, or against all of them when that is fewer, and meet each other in a
+//!   sweep-and-prune (in a periodic domain, by brute force).
 //! * **Layouts.** [`GridLayout::Dense`] spans the bounding box of this frame's centres
 //!   with at most `8N + 64` cells (the cell grows if the scene is sparse), plus one
 //!   empty padding cell on each side so that neighbours are fixed linear offsets;
@@ -177,11 +181,26 @@ fn forward_offsets<const D: usize>() -> Vec<Cell<D>> {
     out
 }
 
+/// Every offset in `{-1, 0, 1}^D`.
+fn all_offsets<const D: usize>() -> Vec<Cell<D>> {
+    (0..3usize.pow(D as u32))
+        .map(|code| {
+            let mut rest = code;
+            core::array::from_fn(|_| {
+                let d = [-1, 0, 1][rest % 3];
+                rest /= 3;
+                d
+            })
+        })
+        .collect()
+}
+
 /// One regular volume in bucket order.
 #[derive(Clone, Copy, Debug)]
 struct Entry<T: Real, const D: usize> {
     proxy: Proxy<T, D>,
     cell: Cell<D>,
+    /// The caller's index (levels hold subsets; see `Store::gid`).
     id: u32,
 }
 
@@ -208,9 +227,18 @@ pub struct UniformGrid<T: Real, const D: usize> {
     regular: Vec<u32>,
     oversized: Vec<u32>,
     oversized_sweep: SweepCore<T, D>,
+    /// The grid over this level's oversized volumes, when there are enough of them.
+    coarser: Option<Box<UniformGrid<T, D>>>,
+    coarser_active: bool,
+    /// All `3^D` neighbour offsets, the cell itself included (for lookups from finer levels).
+    all_offsets: Vec<Cell<D>>,
     selection: Vec<f64>,
     buffers: PairBuffers,
 }
+
+/// From this many oversized volumes on, they get a coarser grid level of their own
+/// instead of walking the cells of this one.
+const COARSER_LEVEL_MIN: usize = 32;
 
 impl<T: Real, const D: usize> UniformGrid<T, D> {
     /// A grid with the given layout and cells sized for volumes up to 2 × the median.
@@ -236,6 +264,9 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             regular: Vec::new(),
             oversized: Vec::new(),
             oversized_sweep: SweepCore::default(),
+            coarser: None,
+            coarser_active: false,
+            all_offsets: all_offsets(),
             selection: Vec::new(),
             buffers: PairBuffers::default(),
         }
@@ -271,9 +302,15 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         &self.layout
     }
 
-    /// How many volumes the last update kept out of the cells.
+    /// How many volumes the last update kept out of the finest cells.
     pub fn oversized(&self) -> usize {
         self.oversized.len()
+    }
+
+    /// How many grid levels the last update built: 1, plus one per coarser level made
+    /// for the oversized volumes of the level below (each at least halves the count).
+    pub fn levels(&self) -> usize {
+        1 + self.coarser_level().map_or(0, Self::levels)
     }
 
     /// The cell counts per axis of the last update (dense and periodic layouts).
@@ -405,21 +442,71 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         }
     }
 
-    /// Emits the pairs among regular volumes starting at entry positions `regular`, the
-    /// pairs of the oversized volumes `oversized` (indices into the oversized list) with
-    /// regular ones, and the oversized–oversized pairs of that share.
-    fn search(
-        &self,
-        regular: core::ops::Range<usize>,
-        oversized: core::ops::Range<usize>,
-        emit: &mut Emitter<'_>,
-    ) {
+    /// Emits share `c` of `chunks` of this level's pairs and of every coarser level's:
+    /// the regular pairs of this level, the pairs of this level's regular volumes with
+    /// coarser levels, and recursively the coarser levels' own (or, without a coarser
+    /// level, the pairs of the oversized volumes).
+    fn search(&self, c: usize, chunks: usize, emit: &mut Emitter<'_>) {
+        let regular = crate::chunk_range(c, chunks, self.entries.len());
         match &self.geometry {
-            Some(g) if !g.hashed && !g.periodic => self.search_dense(g, regular, emit),
-            Some(g) => self.search_general(g, regular, emit),
+            Some(g) if !g.hashed && !g.periodic => self.search_dense(g, regular.clone(), emit),
+            Some(g) => self.search_general(g, regular.clone(), emit),
             None => {}
         }
-        self.search_oversized(oversized, emit);
+        match self.coarser_level() {
+            Some(coarser) => {
+                let (balls, period) = (self.store.balls, self.store.period.as_ref());
+                for a in &self.entries[regular] {
+                    let center = a.proxy.center.map(Real::to_f64).into();
+                    coarser.for_each_near(&center, &mut |p, id| {
+                        if overlap(&a.proxy, p, balls, period) {
+                            emit.push(a.id, id);
+                        }
+                    });
+                }
+                coarser.search(c, chunks, emit);
+            }
+            None => {
+                self.search_oversized(crate::chunk_range(c, chunks, self.oversized.len()), emit);
+            }
+        }
+    }
+
+    /// The coarser level, when this update built one.
+    fn coarser_level(&self) -> Option<&Self> {
+        self.coarser.as_deref().filter(|_| self.coarser_active)
+    }
+
+    /// Calls `f` with every volume of this level and the coarser ones that can overlap a
+    /// volume centred at `center` no larger than this level's volumes (its proxy and
+    /// caller index): the `3^D` cells around the centre's cell, then the coarser level
+    /// (or, without one, every oversized volume). A finer volume is smaller than every
+    /// volume here, and cells are as wide as the largest, so the centres of overlapping
+    /// volumes are at most one cell apart.
+    fn for_each_near(&self, center: &[f64; D], f: &mut dyn FnMut(&Proxy<T, D>, u32)) {
+        if let Some(g) = &self.geometry {
+            let cell = g.cell(center);
+            for offset in &self.all_offsets {
+                let Some(n) = g.neighbour(&cell, offset) else {
+                    continue;
+                };
+                let bucket = g.bucket(&n);
+                for e in &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
+                {
+                    if e.cell == n {
+                        f(&e.proxy, e.id);
+                    }
+                }
+            }
+        }
+        match self.coarser_level() {
+            Some(coarser) => coarser.for_each_near(center, f),
+            None => {
+                for &i in &self.oversized {
+                    f(&self.store.proxies[i as usize], self.store.gid(i));
+                }
+            }
+        }
     }
 
     /// The regular pairs of a dense grid: thanks to the padding, the forward neighbours
@@ -500,10 +587,11 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             let p = &self.store.proxies[i as usize];
             let lo = core::array::from_fn(|k| p.aabb.min()[k].to_f64() - self.reach);
             let hi = core::array::from_fn(|k| p.aabb.max()[k].to_f64() + self.reach);
+            let gi = self.store.gid(i);
             self.for_each_regular_near(&lo, &hi, |m| {
                 let b = &self.entries[m];
                 if overlap(p, &b.proxy, balls, period) {
-                    emit.push(i, b.id);
+                    emit.push(gi, b.id);
                 }
             });
         }
@@ -517,18 +605,40 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             {
                 for &j in &self.oversized[x + 1..] {
                     if self.store.overlap(i as usize, j as usize) {
-                        emit.push(i, j);
+                        emit.push(self.store.gid(i), self.store.gid(j));
                     }
                 }
             }
         } else {
             // The sweep sorted exactly the oversized list: split its positions the same way.
-            self.oversized_sweep.sweep(oversized, balls, emit);
+            self.oversized_sweep
+                .sweep(oversized, balls, &self.store.global, emit);
         }
     }
 
-    /// Query helper: regular candidates near `[lo, hi]` grown by the reach, and the
-    /// oversized ones, filtered by `hit`.
+    /// Calls `f` with the caller index of every volume, on this level and the coarser
+    /// ones, that may meet the box `[lo, hi]`: regular volumes of the cells near it, then
+    /// the coarser level's candidates, or this level's oversized volumes.
+    fn candidates(&self, lo: &[f64; D], hi: &[f64; D], f: &mut dyn FnMut(u32)) {
+        let lo_reach = core::array::from_fn(|k| lo[k] - self.reach);
+        let hi_reach = core::array::from_fn(|k| hi[k] + self.reach);
+        self.for_each_regular_near(&lo_reach, &hi_reach, |m| f(self.entries[m].id));
+        match self.coarser_level() {
+            Some(coarser) => coarser.candidates(lo, hi, f),
+            None if self.store.period.is_some() => {
+                for &i in &self.oversized {
+                    f(self.store.gid(i));
+                }
+            }
+            None => {
+                let axis = self.oversized_sweep.axis();
+                self.oversized_sweep
+                    .candidates(lo[axis], hi[axis], |i| f(self.store.gid(i)));
+            }
+        }
+    }
+
+    /// Query helper: the candidates near `[lo, hi]` that pass `hit`, ascending.
     fn query(
         &self,
         lo: &Vector<T, D>,
@@ -537,24 +647,13 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         out: &mut Vec<u32>,
     ) {
         out.clear();
-        let lo64 = core::array::from_fn(|k| lo[k].to_f64() - self.reach);
-        let hi64 = core::array::from_fn(|k| hi[k].to_f64() + self.reach);
-        self.for_each_regular_near(&lo64, &hi64, |m| {
-            let id = self.entries[m].id;
+        let lo64 = core::array::from_fn(|k| lo[k].to_f64());
+        let hi64 = core::array::from_fn(|k| hi[k].to_f64());
+        self.candidates(&lo64, &hi64, &mut |id| {
             if hit(id as usize) {
                 out.push(id);
             }
         });
-        if self.store.period.is_some() {
-            out.extend(self.oversized.iter().copied().filter(|&j| hit(j as usize)));
-        } else {
-            let axis = self.oversized_sweep.axis();
-            self.oversized_sweep.candidates(lo[axis], hi[axis], |j| {
-                if hit(j as usize) {
-                    out.push(j);
-                }
-            });
-        }
         out.sort_unstable();
     }
 }
@@ -563,6 +662,12 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
     /// The update, its element-wise passes on the rayon pool when `parallel`.
     fn rebuild(&mut self, volumes: Volumes<'_, T, D>, parallel: bool) {
         self.store.load(volumes, parallel);
+        self.rebuild_stored(parallel, 0.0);
+    }
+
+    /// Builds this level from the volumes already in the store; `scale_floor` is the
+    /// coordinate scale of the finer levels, whose centres look up cells here.
+    fn rebuild_stored(&mut self, parallel: bool, scale_floor: f64) {
         let n = self.store.len();
         let proxies = &self.store.proxies;
 
@@ -596,6 +701,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                 self.oversized.push(i as u32);
             }
         }
+        let scale = scale.max(scale_floor);
         self.geometry = self.choose_geometry(cell_width, scale);
         if self.geometry.is_none() {
             self.oversized.clear();
@@ -608,18 +714,23 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             None => 0.0,
         };
 
-        // Sort the regular volumes by bucket as (bucket, index) keys: an insertion sort
-        // from the previous frame's order when the set of regular volumes is unchanged
-        // (coherent frames: few volumes change cells), a radix sort otherwise. Both
-        // give the same order; unlike a counting sort straight into the bucket array,
-        // neither scatters at random over memory the size of the grid.
         self.entries.clear();
         self.start.clear();
-        let Some(g) = self.geometry else {
-            self.keys.clear();
-            self.build_oversized(parallel);
-            return;
-        };
+        match self.geometry {
+            Some(g) => self.sort_into_cells(&g, parallel),
+            None => self.keys.clear(),
+        }
+        self.build_oversized(parallel, scale);
+    }
+
+    /// Sorts the regular volumes by bucket as (bucket, index) keys: an insertion sort
+    /// from the previous frame's order when the set of regular volumes is unchanged
+    /// (coherent frames: few volumes change cells), a radix sort otherwise. Both give
+    /// the same order; unlike a counting sort straight into the bucket array, neither
+    /// scatters at random over memory the size of the grid. Then fills `start` and
+    /// gathers the entries in bucket order.
+    fn sort_into_cells(&mut self, g: &Geometry<D>, parallel: bool) {
+        let n = self.store.len();
         let proxies = &self.store.proxies;
         let cell_of = |id: u32| g.cell(&proxies[id as usize].center.map(Real::to_f64).into());
         // Buckets in index order, a sequential pass over the volumes, so that the
@@ -636,11 +747,15 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         });
         let bucket_of = &self.bucket_of;
         let regular = self.regular.len();
+        // The previous keys name exactly this frame's regular volumes when there are as
+        // many and each is regular (coarser levels renumber their volumes every frame,
+        // so an index may also be out of range).
         let same_set = self.keys.len() == regular
-            && self
-                .keys
-                .iter()
-                .all(|&e| bucket_of[entry_id(e) as usize] != u32::MAX);
+            && self.keys.iter().all(|&e| {
+                bucket_of
+                    .get(entry_id(e) as usize)
+                    .is_some_and(|&b| b != u32::MAX)
+            });
         let coherent = same_set && {
             map_in_place(&mut self.keys, parallel, |e| {
                 entry(bucket_of[entry_id(e) as usize], entry_id(e))
@@ -664,21 +779,31 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             b = bucket + 1;
         }
         self.start[b..].fill(regular as u32);
-        let keys = &self.keys;
+        let (keys, store) = (&self.keys, &self.store);
         extend_indexed(&mut self.entries, regular, parallel, |k| {
             let id = entry_id(keys[k]);
             Entry {
                 proxy: proxies[id as usize],
                 cell: cell_of(id),
-                id,
+                id: store.gid(id),
             }
         });
-        self.build_oversized(parallel);
     }
 
-    /// Sorts the oversized volumes for their sweep (open space only).
-    fn build_oversized(&mut self, parallel: bool) {
-        if self.store.period.is_none() {
+    /// Puts the oversized volumes in a coarser level when there are enough of them (and
+    /// this level has cells), or sorts them for their sweep (open space).
+    fn build_oversized(&mut self, parallel: bool, scale: f64) {
+        self.coarser_active = self.geometry.is_some() && self.oversized.len() >= COARSER_LEVEL_MIN;
+        if self.coarser_active {
+            let coarser = self
+                .coarser
+                .get_or_insert_with(|| Box::new(Self::new(self.layout)));
+            coarser.oversize_ratio = self.oversize_ratio;
+            coarser
+                .store
+                .load_subset(&self.store, &self.oversized, parallel);
+            coarser.rebuild_stored(parallel, scale);
+        } else if self.store.period.is_none() {
             self.oversized_sweep.build(
                 &self.store,
                 Some(&self.oversized),
@@ -702,11 +827,7 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
         let n = self.store.len();
         let mut buffers = core::mem::take(&mut self.buffers);
         buffers.prepare(n, 1, 1);
-        self.search(
-            0..self.entries.len(),
-            0..self.oversized.len(),
-            &mut buffers.emitter(),
-        );
+        self.search(0, 1, &mut buffers.emitter());
         buffers.sort_into(out);
         self.buffers = buffers;
     }
@@ -743,7 +864,7 @@ impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for UniformGrid<T,
 
     fn par_pairs(&mut self, out: &mut Vec<Pair>) {
         use rayon::prelude::*;
-        let (n, r, m) = (self.store.len(), self.entries.len(), self.oversized.len());
+        let n = self.store.len();
         let chunks = crate::parallel_chunks();
         let mut buffers = core::mem::take(&mut self.buffers);
         buffers.prepare(n, chunks, chunks);
@@ -752,10 +873,7 @@ impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for UniformGrid<T,
             .emitters()
             .into_par_iter()
             .enumerate()
-            .for_each(|(c, mut emit)| {
-                let regular = crate::chunk_range(c, chunks, r);
-                this.search(regular, crate::chunk_range(c, chunks, m), &mut emit);
-            });
+            .for_each(|(c, mut emit)| this.search(c, chunks, &mut emit));
         buffers.par_sort_into(out);
         self.buffers = buffers;
     }
@@ -764,6 +882,41 @@ impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for UniformGrid<T,
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::BruteForce;
+    use crate::scenes::Scene;
+
+    fn brute_pairs<const D: usize>(
+        volumes: Volumes<'_, f64, D>,
+        border: Option<&Border<f64, D>>,
+    ) -> Vec<Pair> {
+        let mut brute = border.map_or_else(BruteForce::new, BruteForce::periodic);
+        brute.update(volumes);
+        let mut pairs = Vec::new();
+        brute.pairs(&mut pairs);
+        pairs
+    }
+
+    #[test]
+    fn mixed_radii_build_coarser_levels_that_find_every_pair() {
+        let scene = Scene::<f64, 3>::mixed(3000, 1e-3, 1.0, 0.2, 11);
+        let expected = brute_pairs(scene.balls(), None);
+        for mut grid in [UniformGrid::dense(), UniformGrid::hashed()] {
+            grid.update(scene.balls());
+            assert!(grid.levels() >= 3, "{} levels", grid.levels());
+            let mut pairs = Vec::new();
+            grid.pairs(&mut pairs);
+            assert_eq!(pairs, expected);
+        }
+        // Periodic: the scene's cube as the domain.
+        let scene = Scene::<f64, 2>::mixed(2000, 1e-2, 1.0, 0.3, 12);
+        let expected = brute_pairs(scene.balls(), Some(&scene.domain));
+        let mut grid = UniformGrid::periodic(scene.domain);
+        grid.update(scene.balls());
+        assert!(grid.levels() >= 2, "{} levels", grid.levels());
+        let mut pairs = Vec::new();
+        grid.pairs(&mut pairs);
+        assert_eq!(pairs, expected);
+    }
 
     #[test]
     fn forward_offsets_are_half_of_the_neighbours() {

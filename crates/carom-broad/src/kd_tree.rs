@@ -139,7 +139,7 @@ impl<T: Real, const D: usize> KdTree<T, D> {
             });
         }
         self.oversized_sweep
-            .sweep(oversized, self.store.balls, emit);
+            .sweep(oversized, self.store.balls, &[], emit);
     }
 
     fn query(
@@ -157,11 +157,12 @@ impl<T: Real, const D: usize> KdTree<T, D> {
                 out.push(j);
             }
         });
-        self.oversized_sweep.candidates(lo_hi.0, lo_hi.1, |j| {
-            if hit(j as usize) {
-                out.push(j);
-            }
-        });
+        self.oversized_sweep
+            .candidates(lo_hi.0.to_f64(), lo_hi.1.to_f64(), |j| {
+                if hit(j as usize) {
+                    out.push(j);
+                }
+            });
         out.sort_unstable();
     }
 }

@@ -200,13 +200,22 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
     }
 
     /// Sweeps the sorted positions `range`, emitting every overlapping pair whose first
-    /// volume (in sweep order) is in `range`.
+    /// volume (in sweep order) is in `range`, as caller indices through `global` (empty:
+    /// the store's indices are the caller's).
     pub(crate) fn sweep(
         &self,
         range: core::ops::Range<usize>,
         balls: bool,
+        global: &[u32],
         emit: &mut Emitter<'_>,
     ) {
+        let gid = |i: u32| {
+            if global.is_empty() {
+                i
+            } else {
+                global[i as usize]
+            }
+        };
         for k in range {
             let a = self.keys[k];
             // Every later volume starts at or after `a` on the sweep axis, so it overlaps
@@ -218,7 +227,7 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
                 }
                 if a.overlap_off_axis(b) && overlap(&self.proxies[k], &self.proxies[j], balls, None)
                 {
-                    emit.push(self.ids[k], self.ids[j]);
+                    emit.push(gid(self.ids[k]), gid(self.ids[j]));
                 }
             }
         }
@@ -226,13 +235,12 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
 
     /// Calls `f` with the index of every volume whose lower bound on the sweep axis lies
     /// in `[lo − max_extent, hi]`: a superset of the volumes whose boxes meet `[lo, hi]`.
-    pub(crate) fn candidates(&self, lo: T, hi: T, mut f: impl FnMut(u32)) {
+    pub(crate) fn candidates(&self, lo: f64, hi: f64, mut f: impl FnMut(u32)) {
         let n = self.len();
         // Grow the extent by a few ulp so that its rounding cannot shrink the window,
         // then step one f32 below the key of the difference to cover its rounding.
-        let from =
-            key_down(lo.to_f64() - self.max_extent * (1.0 + 4.0 * f64::EPSILON)).saturating_sub(1);
-        let to = key_up(hi.to_f64());
+        let from = key_down(lo - self.max_extent * (1.0 + 4.0 * f64::EPSILON)).saturating_sub(1);
+        let to = key_up(hi);
         let first = self.keys[..n].partition_point(|k| k.min[0] < from);
         let last = self.keys[..n].partition_point(|k| k.min[0] <= to);
         for &id in &self.ids[first..last.max(first)] {
@@ -317,7 +325,7 @@ impl<T: Real, const D: usize> SweepAndPrune<T, D> {
 
     fn query(&self, lo: T, hi: T, hit: impl Fn(usize) -> bool, out: &mut Vec<u32>) {
         out.clear();
-        self.core.candidates(lo, hi, |id| {
+        self.core.candidates(lo.to_f64(), hi.to_f64(), |id| {
             if hit(id as usize) {
                 out.push(id);
             }
@@ -340,7 +348,7 @@ impl<T: Real, const D: usize> BroadPhase<T, D> for SweepAndPrune<T, D> {
         let n = self.store.len();
         self.buffers.prepare(n, 1, 1);
         self.core
-            .sweep(0..n, self.store.balls, &mut self.buffers.emitter());
+            .sweep(0..n, self.store.balls, &[], &mut self.buffers.emitter());
         self.buffers.sort_into(out);
     }
 
@@ -379,7 +387,7 @@ impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for SweepAndPrune<
             .into_par_iter()
             .enumerate()
             .for_each(|(c, mut emit)| {
-                core.sweep(crate::chunk_range(c, chunks, n), balls, &mut emit);
+                core.sweep(crate::chunk_range(c, chunks, n), balls, &[], &mut emit);
             });
         self.buffers.par_sort_into(out);
     }

@@ -300,11 +300,15 @@ pub(crate) struct Store<T: Real, const D: usize> {
     pub(crate) balls: bool,
     /// The periods of a periodic domain.
     pub(crate) period: Option<Vector<T, D>>,
+    /// The caller's index of each volume when this store holds a subset of another
+    /// (a coarser grid level); empty when the indices are the caller's already.
+    pub(crate) global: Vec<u32>,
 }
 
 impl<T: Real, const D: usize> Store<T, D> {
     /// Copies the volumes in (reusing the buffer).
     pub(crate) fn load(&mut self, volumes: Volumes<'_, T, D>, parallel: bool) {
+        self.global.clear();
         self.proxies.clear();
         match volumes {
             Volumes::Boxes(boxes) => {
@@ -319,6 +323,30 @@ impl<T: Real, const D: usize> Store<T, D> {
                     Proxy::from_ball(&b.centers[i], b.radii[i] + b.margin)
                 });
             }
+        }
+    }
+
+    /// Copies the volumes `ids` of `parent` (with their caller indices and settings).
+    pub(crate) fn load_subset(&mut self, parent: &Self, ids: &[u32], parallel: bool) {
+        self.balls = parent.balls;
+        self.period = parent.period;
+        self.proxies.clear();
+        extend_indexed(&mut self.proxies, ids.len(), parallel, |x| {
+            parent.proxies[ids[x] as usize]
+        });
+        self.global.clear();
+        extend_indexed(&mut self.global, ids.len(), parallel, |x| {
+            parent.gid(ids[x])
+        });
+    }
+
+    /// The caller's index of volume `i`.
+    #[inline]
+    pub(crate) fn gid(&self, i: u32) -> u32 {
+        if self.global.is_empty() {
+            i
+        } else {
+            self.global[i as usize]
         }
     }
 
