@@ -6,12 +6,12 @@
 //! radii), then ask for the overlapping [`Pair`]s, query a box, or query a ball. The
 //! crate knows indices and bounding volumes only, never shapes or bodies.
 //!
-//! | type | how | best for |
+//! | type | how | best for (measured, see the docs) |
 //! |---|---|---|
-//! | [`BruteForce`] | every pair | a few dozen volumes; the oracle of the tests |
-//! | [`SweepAndPrune`] | sort on the axis of largest variance, sweep | any density, mixed sizes, coherent frames |
-//! | [`KdTree`] | kiddo k-d tree over centres, radius queries | balls of similar size, many queries |
-//! | [`UniformGrid`] | cells the size of a typical volume: dense, hashed or periodic | dense scenes of similar sizes, periodic boxes |
+//! | [`BruteForce`] | every pair | up to ~100 volumes; the oracle of the tests |
+//! | [`SweepAndPrune`] | sort on the axis of largest variance, sweep | ~100–1,000 volumes; mixed sizes in 2D |
+//! | [`KdTree`] | kiddo k-d tree over centres, radius queries | very mixed sizes in 3D up to ~1e4 |
+//! | [`UniformGrid`] | cells the size of a typical volume, coarser levels for big ones; dense, hashed or periodic | most scenes above ~1,000 volumes; periodic boxes |
 //!
 //! `docs/broad-phase.md` has the measured table and a guide to picking one.
 //!
