@@ -147,3 +147,56 @@ fn invalid_toml_reports_the_line() {
     let e = error("dim = 2\n[[balls]\n");
     assert!(e.contains("line 2"), "{e}");
 }
+
+#[test]
+fn overlapping_balls_are_refused_touching_ones_are_not() {
+    let two = |x: f64| {
+        format!(
+            "dim = 2\n[[balls]]\npos = [0.0, 0.0]\nradius = 0.5\nmass = 1\n[[balls]]\npos = [{x}, 0.0]\nradius = 0.5\nmass = 1\n"
+        )
+    };
+    assert!(parse_scene(&two(1.0)).is_ok(), "touching is allowed");
+    assert!(
+        parse_scene(&two(1.0 - 5e-10)).is_ok(),
+        "overlap within 1e-9 is allowed"
+    );
+    let e = error(&two(0.9));
+    assert!(
+        e.starts_with("balls[1].pos: overlaps balls[0] by 1.000e-1 m"),
+        "{e}"
+    );
+}
+
+#[test]
+fn overlaps_count_across_a_periodic_boundary() {
+    let text = "dim = 2\n[world.border]\nmin = [0.0, 0.0]\nmax = [10.0, 10.0]\nperiodic = true\n\
+                [[balls]]\npos = [0.2, 5.0]\nradius = 0.5\nmass = 1\n[[balls]]\npos = [9.7, 5.0]\nradius = 0.5\nmass = 1\n";
+    let e = error(text);
+    assert!(e.starts_with("balls[1].pos: overlaps balls[0]"), "{e}");
+}
+
+#[test]
+fn a_ball_inside_a_box_is_refused() {
+    let text = "dim = 3\n[[boxes]]\ncenter = [0.0, 0.0, 0.0]\nhalf_extents = [1.0, 1.0, 0.1]\naxis_angle = [0.0, 0.3, 0.0]\n\
+                [[balls]]\npos = [0.0, 0.0, 0.2]\nradius = 0.2\nmass = 1\n";
+    let e = error(text);
+    assert!(e.starts_with("balls[0].pos: overlaps boxes[0]"), "{e}");
+    let resting = "dim = 2\n[[boxes]]\ncenter = [0.0, -0.5]\nhalf_extents = [1.0, 0.5]\n[[balls]]\npos = [0.3, 0.2]\nradius = 0.2\nmass = 1\n";
+    assert!(
+        parse_scene(resting).is_ok(),
+        "a ball resting on a box touches it"
+    );
+}
+
+#[test]
+fn a_large_gas_is_validated_quickly_and_accepted() {
+    use carom_sim::scenes::gas::{GasParams, gas};
+    let scene = gas::<3>(&GasParams {
+        n: 50_000,
+        fraction: 0.45,
+        periodic: true,
+        ..GasParams::default()
+    })
+    .unwrap();
+    scene.validate().unwrap();
+}

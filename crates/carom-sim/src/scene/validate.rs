@@ -11,6 +11,10 @@ use carom_math::{
     InvalidValue, Real, ensure_finite_vector, ensure_in_range, ensure_non_negative, ensure_positive,
 };
 
+use carom_broad::{Balls, BroadPhase, UniformGrid};
+use carom_geometry::query::PointQuery;
+use carom_math::Vector;
+
 use super::Scene;
 
 /// How much two bodies may overlap at the start (m): touching (gap 0) is allowed,
@@ -138,6 +142,66 @@ impl<T: Real, const D: usize> Scene<T, D> {
                             b.pos[k] + r,
                             lo[k],
                             hi[k]
+                        ),
+                    ));
+                }
+            }
+        }
+        self.validate_ball_overlaps()?;
+        self.validate_box_overlaps()
+    }
+
+    /// No two balls overlap by more than [`OVERLAP_TOLERANCE`] (minimum image in a
+    /// periodic box). Candidate pairs come from a carom-broad uniform grid, so large
+    /// scenes are checked in about linear time.
+    fn validate_ball_overlaps(&self) -> Result<(), SceneError> {
+        if self.balls.len() < 2 {
+            return Ok(());
+        }
+        let centers: Vec<Vector<T, D>> = self.balls.iter().map(|b| b.pos).collect();
+        let radii: Vec<T> = self.balls.iter().map(|b| b.radius).collect();
+        let periodic = self.world.border.filter(|b| b.periodic).map(|b| b.border);
+        let mut grid = match periodic {
+            Some(border) => UniformGrid::periodic(border),
+            None => UniformGrid::hashed(),
+        };
+        grid.update(Balls::new_unchecked(&centers, &radii).into());
+        let mut pairs = Vec::new();
+        grid.pairs(&mut pairs);
+        let tol = T::lit(OVERLAP_TOLERANCE);
+        for &(i, j) in &pairs {
+            let (i, j) = (i as usize, j as usize);
+            let d = centers[j] - centers[i];
+            let d = periodic.map_or(d, |b| b.minimum_image(&d));
+            let overlap = radii[i] + radii[j] - d.norm();
+            if overlap > tol {
+                return Err(SceneError::new(
+                    format!("balls[{j}].pos"),
+                    format!(
+                        "overlaps balls[{i}] by {:.3e} m at the start (at most 1e-9 m is allowed)",
+                        overlap.to_f64()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// No ball overlaps a box by more than [`OVERLAP_TOLERANCE`] at the start.
+    fn validate_box_overlaps(&self) -> Result<(), SceneError> {
+        let periodic = self.world.border.filter(|b| b.periodic).map(|b| b.border);
+        let tol = T::lit(OVERLAP_TOLERANCE);
+        for (k, b) in self.boxes.iter().enumerate() {
+            for (i, ball) in self.balls.iter().enumerate() {
+                let d = ball.pos - b.shape.center();
+                let image = b.shape.center() + periodic.map_or(d, |p| p.minimum_image(&d));
+                let overlap = ball.radius - b.shape.signed_distance_to_point(&image);
+                if overlap > tol {
+                    return Err(SceneError::new(
+                        format!("balls[{i}].pos"),
+                        format!(
+                            "overlaps boxes[{k}] by {:.3e} m at the start (at most 1e-9 m is allowed)",
+                            overlap.to_f64()
                         ),
                     ));
                 }
