@@ -1,9 +1,9 @@
 //! The exact event-driven engine: Collision Lab's continuous engine, generalised.
 //!
-//! Every collision is predicted exactly (carom-toi) and kept in an [`Calendar`](calendar::Calendar)
+//! Every collision is predicted exactly (carom-toi) and kept in a [`Calendar`]
 //! with one pending event per ball; the engine jumps from event to event, applies the
 //! response (carom-response) and re-predicts only the balls that changed. Balls are
-//! advanced lazily ([`state`]); partners come from symmetric neighbour lists with a shell
+//! advanced lazily (the `state` module); partners come from symmetric neighbour lists with a shell
 //! ([`neighbours`]) or, for a handful of balls, from every pair. Nothing tunnels at any
 //! speed, and positions at contact are exact (touching, not overlapping).
 //!
