@@ -16,6 +16,7 @@
 //! | `toi`       | [`toi`]            | exact time of impact                                    |
 //! | `response`  | [`response`]       | collision impulses, clusters, guards                    |
 //! | `integrate` | [`integrate`]      | integrators and force fields                            |
+//! | `sim`       | [`sim`]            | the engines, scenes and planner                         |
 //! | `glam`      |                    | `From`/`Into` between nalgebra vectors and glam 0.33    |
 //!
 //! [`d2`] and [`d3`] gather the concrete per-dimension aliases (`carom::d2::Ball`).
@@ -31,6 +32,8 @@ pub use carom_geometry as geometry;
 pub use carom_integrate as integrate;
 #[cfg(feature = "response")]
 pub use carom_response as response;
+#[cfg(feature = "sim")]
+pub use carom_sim as sim;
 #[cfg(feature = "toi")]
 pub use carom_toi as toi;
 

@@ -98,24 +98,63 @@ impl<T: Real, const D: usize> Border<T, D> {
     }
 
     /// The periodic image of `p` in `[min, max)` on every axis.
+    ///
+    /// A point at most one period outside (a ball that just crossed a face) is shifted by
+    /// one period with a comparison; only points farther away use the general
+    /// `floor` formula.
+    #[inline]
     pub fn wrap(&self, p: &Vector<T, D>) -> Vector<T, D> {
-        let (lo, len) = (self.min(), self.extents());
+        let (lo, hi, len) = (self.min(), self.max(), self.extents());
         Vector::<T, D>::from_fn(|i, _| {
-            let u = (p[i] - lo[i]) / len[i];
-            let mut x = lo[i] + (u - u.floor()) * len[i];
-            // Rounding can land exactly on the upper face; that point is the lower face.
-            if x >= lo[i] + len[i] {
-                x = lo[i];
+            let x = p[i];
+            let near = if x < lo[i] {
+                x + len[i]
+            } else if x >= hi[i] {
+                x - len[i]
+            } else {
+                return x;
+            };
+            if near >= lo[i] && near < hi[i] {
+                return near;
             }
-            x
+            let u = (x - lo[i]) / len[i];
+            let mut y = lo[i] + (u - u.floor()) * len[i];
+            // Rounding can land exactly on the upper face; that point is the lower face.
+            if y >= hi[i] {
+                y = lo[i];
+            }
+            y
         })
     }
 
     /// The minimum image of the separation `delta` in a periodic border: each
     /// component shifted by a whole number of periods into `[−L/2, L/2]`.
+    ///
+    /// Separations of points inside the box are within one period, and are shifted with
+    /// a comparison; only larger ones use `round`.
+    #[inline]
     pub fn minimum_image(&self, delta: &Vector<T, D>) -> Vector<T, D> {
         let len = self.extents();
-        Vector::<T, D>::from_fn(|i, _| delta[i] - len[i] * (delta[i] / len[i]).round())
+        Vector::<T, D>::from_fn(|i, _| {
+            let (d, l) = (delta[i], len[i]);
+            let h = l * T::lit(0.5);
+            // For d > L/2, d − L > −L/2 always; it is the image if also d − L <= L/2.
+            if d > h {
+                if d - l <= h {
+                    d - l
+                } else {
+                    d - l * (d / l).round()
+                }
+            } else if d < -h {
+                if d + l >= -h {
+                    d + l
+                } else {
+                    d - l * (d / l).round()
+                }
+            } else {
+                d
+            }
+        })
     }
 }
 
@@ -167,6 +206,32 @@ mod tests {
         // Just below the lower face by less than an ulp of the period.
         let w = b.wrap(&Vector3::new(-1e-17, 0.0, 0.0));
         assert!(w.x >= 0.0 && w.x < 1.0);
+    }
+
+    #[test]
+    fn wrap_and_minimum_image_agree_with_the_floor_and_round_formulas() {
+        let b = Border::new(Vector2::new(-1.5, 0.0), Vector2::new(2.5, 0.75)).unwrap();
+        let len = b.extents();
+        let mut x = -13.37_f64;
+        while x < 13.0 {
+            let p = Vector2::new(x, x * 0.61);
+            let w = b.wrap(&p);
+            for i in 0..2 {
+                let u = (p[i] - b.min()[i]) / len[i];
+                let reference = b.min()[i] + (u - u.floor()) * len[i];
+                assert!(
+                    (w[i] - reference).abs() < 1e-12 || (w[i] - reference).abs() > len[i] - 1e-12,
+                    "{x}"
+                );
+                assert!(w[i] >= b.min()[i] && w[i] < b.max()[i]);
+                let d = b.minimum_image(&p)[i];
+                assert!(
+                    (d - (p[i] - len[i] * (p[i] / len[i]).round())).abs() < 1e-12,
+                    "{x}"
+                );
+            }
+            x += 0.0173;
+        }
     }
 
     #[test]

@@ -36,6 +36,23 @@ pub type Rotation<T, const D: usize> = nalgebra::Rotation<T, D>;
 /// The marker type that selects dimension-specific code: `Dim<2>` or `Dim<3>`.
 pub type Dim<const D: usize> = nalgebra::Const<D>;
 
+/// `⌊x⌋` as an `i64` (saturating at the `i64` range, 0 for NaN), without calling libm.
+///
+/// On the baseline x86-64 target (no SSE4.1) `f64::floor` and `f64::round` are library
+/// calls costing tens of instructions; cell indices and calendar buckets are computed
+/// millions of times per second, so this uses the truncating conversion and corrects
+/// it for negative non-integers.
+#[inline]
+pub fn floor_to_i64<T: Real>(x: T) -> i64 {
+    let x = x.to_f64();
+    let t = x as i64;
+    if (t as f64) > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
 /// The determinant of a small square matrix by Gaussian elimination with partial
 /// pivoting (nalgebra's `determinant` needs type-level dimensions that generic
 /// `const D` code cannot name). Exact for permutation and diagonal matrices; otherwise
@@ -74,6 +91,28 @@ pub fn determinant<T: Real, const D: usize>(m: &nalgebra::SMatrix<T, D, D>) -> T
 #[cfg(test)]
 mod tests {
     use nalgebra::{Matrix2, Matrix3};
+
+    #[test]
+    fn floor_to_i64_matches_floor_and_saturates() {
+        for x in [
+            -2.5_f64,
+            -2.0,
+            -1e-300,
+            -0.0,
+            0.0,
+            0.3,
+            1.0,
+            7.9,
+            1e17 + 3.0,
+            -1e17 - 3.0,
+        ] {
+            assert_eq!(super::floor_to_i64(x), x.floor() as i64, "{x}");
+        }
+        assert_eq!(super::floor_to_i64(-0.5_f32), -1);
+        assert_eq!(super::floor_to_i64(1e300_f64), i64::MAX);
+        assert_eq!(super::floor_to_i64(-1e300_f64), i64::MIN);
+        assert_eq!(super::floor_to_i64(f64::NAN), 0);
+    }
 
     #[test]
     fn determinant_matches_the_closed_forms() {

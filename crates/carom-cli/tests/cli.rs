@@ -1,0 +1,231 @@
+//! `carom run` against its contract (docs/scene-format.md): output lines, exit statuses,
+//! one-line errors naming the file and the field.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn carom(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_carom"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// Writes `text` to a fresh scene file and returns its path.
+fn scene_file(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("carom-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+const INTRO: &str = r#"
+dim = 2
+name = "intro"
+[world.border]
+min = [-2.0, -0.55]
+max = [2.0, 0.55]
+[[balls]]
+pos = [-1.0, 0.0]
+vel = [1.0, 0.0]
+radius = 0.15
+mass = 0.5
+[[balls]]
+pos = [1.0, 0.0]
+vel = [-0.5, 0.0]
+radius = 0.15
+mass = 1.5
+"#;
+
+fn lines(out: &Output) -> Vec<Value> {
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout.clone())
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("not JSON: {l}: {e}")))
+        .collect()
+}
+
+#[test]
+fn a_run_prints_samples_events_and_one_summary_in_time_order() {
+    let path = scene_file("intro.toml", INTRO);
+    let out = lines(&carom(&[
+        "run",
+        path.to_str().unwrap(),
+        "--until",
+        "3",
+        "--every",
+        "1",
+        "--events",
+    ]));
+    let summary = out.last().unwrap();
+    assert_eq!(summary["summary"]["engine"], "event");
+    assert_eq!(summary["summary"]["ball_ball"], 1);
+    assert_eq!(summary["summary"]["ball_border"], 1);
+    let pipeline: Vec<&str> = summary["summary"]["pipeline"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap())
+        .collect();
+    assert!(
+        pipeline.contains(&"toi:ball-border") && !pipeline.contains(&"toi:ball-box"),
+        "{pipeline:?}"
+    );
+    let (e0, e1) = (
+        summary["summary"]["energy_initial"].as_f64().unwrap(),
+        summary["summary"]["energy_final"].as_f64().unwrap(),
+    );
+    assert!((e0 - e1).abs() < 1e-12 && (e0 - 0.4375).abs() < 1e-15);
+    let times: Vec<f64> = out[..out.len() - 1]
+        .iter()
+        .map(|l| l["t"].as_f64().unwrap())
+        .collect();
+    assert!(
+        times.windows(2).all(|w| w[0] <= w[1]),
+        "time order: {times:?}"
+    );
+    let samples: Vec<&Value> = out.iter().filter(|l| l.get("pos").is_some()).collect();
+    assert_eq!(samples.len(), 4, "t = 0, 1, 2, 3");
+    let event = out.iter().find(|l| l["event"] == "ball-ball").unwrap();
+    assert!((event["t"].as_f64().unwrap() - 1.7 / 1.5).abs() < 1e-14);
+    assert_eq!(
+        (event["i"].as_u64(), event["j"].as_u64()),
+        (Some(0), Some(1))
+    );
+    // After the collision: Collision Lab's −1.25 and 0.25 m/s.
+    assert_eq!(samples[2]["vel"][0][0].as_f64(), Some(-1.25));
+    assert_eq!(samples[2]["vel"][1][0].as_f64(), Some(0.25));
+}
+
+#[test]
+fn a_backward_run_then_forward_returns_to_the_start() {
+    let path = scene_file("intro-back.toml", INTRO);
+    let out = lines(&carom(&[
+        "run",
+        path.to_str().unwrap(),
+        "--until",
+        "-4",
+        "--events",
+    ]));
+    let end = &out[out.len() - 2];
+    assert_eq!(end["t"].as_f64(), Some(-4.0));
+    let summary = &out[out.len() - 1]["summary"];
+    assert!(summary["ball_ball"].as_u64().unwrap() >= 1);
+    // Run forward from the state at −4 for 4 s: back to the initial state.
+    let back = format!(
+        "dim = 2\n[world.border]\nmin = [-2.0, -0.55]\nmax = [2.0, 0.55]\n[[balls]]\npos = {}\nvel = {}\nradius = 0.15\nmass = 0.5\n[[balls]]\npos = {}\nvel = {}\nradius = 0.15\nmass = 1.5\n",
+        end["pos"][0], end["vel"][0], end["pos"][1], end["vel"][1]
+    );
+    let path = scene_file("intro-forward.toml", &back);
+    let out = lines(&carom(&["run", path.to_str().unwrap(), "--until", "4"]));
+    let last = &out[out.len() - 2];
+    for (k, x) in [(0, -1.0), (1, 1.0)] {
+        assert!(
+            (last["pos"][k][0].as_f64().unwrap() - x).abs() < 1e-12,
+            "{last}"
+        );
+    }
+}
+
+#[test]
+fn f32_precision_prints_single_precision_numbers() {
+    let path = scene_file("intro-f32.toml", INTRO);
+    let out = lines(&carom(&[
+        "run",
+        path.to_str().unwrap(),
+        "--until",
+        "2",
+        "--precision",
+        "f32",
+    ]));
+    assert_eq!(out[0]["vel"][0][0].as_f64(), Some(-1.25));
+}
+
+fn failure(args: &[&str]) -> String {
+    let out = carom(args);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "stdout: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(out.stdout.is_empty(), "nothing is simulated");
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.lines().count(), 1, "one line: {err}");
+    err
+}
+
+#[test]
+fn bad_scenes_exit_2_with_one_line_naming_the_file_and_the_field() {
+    let path = scene_file(
+        "bad.toml",
+        &INTRO.replace("radius = 0.15\nmass = 1.5", "radius = -0.15\nmass = 1.5"),
+    );
+    let err = failure(&["run", path.to_str().unwrap(), "--until", "1"]);
+    assert!(
+        err.contains("bad.toml: balls[1].radius: must be > 0, got -0.15"),
+        "{err}"
+    );
+    let path = scene_file("typo.toml", &INTRO.replace("mass = 0.5", "mas = 0.5"));
+    let err = failure(&["run", path.to_str().unwrap(), "--until", "1"]);
+    assert!(
+        err.contains("typo.toml: balls[0].mas: unknown key `mas`"),
+        "{err}"
+    );
+    let path = scene_file(
+        "outside.toml",
+        &INTRO.replace("pos = [1.0, 0.0]", "pos = [1.9, 0.0]"),
+    );
+    let err = failure(&["run", path.to_str().unwrap(), "--until", "1"]);
+    assert!(
+        err.contains("balls[1].pos: the ball must start inside the border"),
+        "{err}"
+    );
+    let err = failure(&["run", "/nonexistent/scene.toml", "--until", "1"]);
+    assert!(
+        err.contains("/nonexistent/scene.toml: cannot read the scene file"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_flags_exit_2() {
+    let path = scene_file("flags.toml", INTRO);
+    let p = path.to_str().unwrap();
+    assert!(
+        failure(&[
+            "run", p, "--until", "1", "--engine", "event", "--dt", "0.01"
+        ])
+        .contains("--integrator and --dt")
+    );
+    assert!(failure(&["run", p, "--until", "1", "--at", "2"]).contains("--at"));
+    assert!(failure(&["run", p, "--until", "1", "--engine", "fast"]).contains("fast"));
+    assert!(failure(&["run", p, "--until", "nan"]).contains("--until"));
+    assert!(failure(&["run", p]).contains("--until"));
+    assert!(failure(&["run", p, "--until", "1", "--threads", "0"]).contains("--threads"));
+}
+
+#[test]
+fn the_output_file_receives_the_lines() {
+    let path = scene_file("out.toml", INTRO);
+    let out_path = path.with_file_name("out.jsonl");
+    let out = carom(&[
+        "run",
+        path.to_str().unwrap(),
+        "--until",
+        "1",
+        "--out",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success() && out.stdout.is_empty());
+    let text = std::fs::read_to_string(out_path).unwrap();
+    assert_eq!(text.lines().count(), 2, "one sample and the summary");
+}

@@ -1,0 +1,189 @@
+//! What every engine offers the programs that drive it.
+//!
+//! [`Simulation`] is the common face of the event-driven and the time-stepped engine:
+//! advance to a time (reporting collisions as they happen), read the state of every
+//! ball, and the counters. Drivers — `carom run`, the examples, the report — only talk
+//! to this trait, so a scene runs the same way on either engine.
+//!
+//! Times are signed: a simulation that runs backwards (`carom run --until -T`) has
+//! decreasing times, and [`Simulation::advance_to`] is called with decreasing targets.
+
+use core::fmt;
+
+use carom_math::{Real, Space, Vector};
+use nalgebra::Const;
+
+/// An angular velocity: `Vector1` in 2D (the z component), `Vector3` in 3D.
+pub type Angular<T, const D: usize> = <Const<D> as Space<T, D>>::Angular;
+
+/// Which engine runs a scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EngineKind {
+    /// The exact event-driven engine.
+    Event,
+    /// The time-stepped engine.
+    Stepped,
+}
+
+impl fmt::Display for EngineKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            EngineKind::Event => "event",
+            EngineKind::Stepped => "stepped",
+        })
+    }
+}
+
+/// A collision an engine processed, at the (signed) simulation time it happened.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Collision<T: Real> {
+    /// Balls `i < j` collided.
+    BallBall {
+        /// When.
+        time: T,
+        /// The lower ball index.
+        i: usize,
+        /// The higher ball index.
+        j: usize,
+    },
+    /// Ball `i` bounced off the border.
+    BallBorder {
+        /// When.
+        time: T,
+        /// The ball.
+        i: usize,
+    },
+    /// Ball `i` bounced off box `k`.
+    BallBox {
+        /// When.
+        time: T,
+        /// The ball.
+        i: usize,
+        /// The box, in scene order.
+        k: usize,
+    },
+}
+
+impl<T: Real> Collision<T> {
+    /// When the collision happened.
+    pub fn time(&self) -> T {
+        match *self {
+            Collision::BallBall { time, .. }
+            | Collision::BallBorder { time, .. }
+            | Collision::BallBox { time, .. } => time,
+        }
+    }
+}
+
+/// The number of collisions of each kind so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Ball–ball collisions.
+    pub ball_ball: u64,
+    /// Ball–border bounces.
+    pub ball_border: u64,
+    /// Ball–box bounces.
+    pub ball_box: u64,
+}
+
+/// The state of every ball at one time, in scene order: the centre, the velocity of the
+/// centre, and the angular velocity (a ball in a stuck cluster reports its own centre,
+/// its centre's velocity and the cluster's angular velocity).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BallStates<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Centres.
+    pub pos: Vec<Vector<T, D>>,
+    /// Velocities.
+    pub vel: Vec<Vector<T, D>>,
+    /// Angular velocities.
+    pub spin: Vec<Angular<T, D>>,
+}
+
+impl<T: Real, const D: usize> Default for BallStates<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    fn default() -> Self {
+        Self {
+            pos: Vec::new(),
+            vel: Vec::new(),
+            spin: Vec::new(),
+        }
+    }
+}
+
+impl<T: Real, const D: usize> BallStates<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Clears and reserves room for `n` balls.
+    pub fn reset(&mut self, n: usize) {
+        self.pos.clear();
+        self.vel.clear();
+        self.spin.clear();
+        self.pos.reserve(n);
+        self.vel.reserve(n);
+        self.spin.reserve(n);
+    }
+}
+
+/// Receives what happens during [`Simulation::advance_to`]; both methods default to
+/// doing nothing.
+pub trait Observer<T: Real> {
+    /// A collision was processed.
+    fn collision(&mut self, collision: &Collision<T>) {
+        let _ = collision;
+    }
+    /// The simulation has reached time `t` (called every few thousand events or steps).
+    fn progress(&mut self, t: T) {
+        let _ = t;
+    }
+}
+
+/// An observer that ignores everything.
+impl<T: Real> Observer<T> for () {}
+
+/// A failure while running: the state is no longer trustworthy, so the run stops.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("at t = {time}: {message}")]
+pub struct SimError {
+    /// The simulation time of the failure.
+    pub time: f64,
+    /// What went wrong.
+    pub message: String,
+}
+
+/// The common face of carom's engines.
+pub trait Simulation<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Which engine this is.
+    fn kind(&self) -> EngineKind;
+
+    /// The components this run uses, e.g. `["event-driven", "neighbour-lists", ...]`: what
+    /// the scene does not need is not in it.
+    fn pipeline(&self) -> Vec<String>;
+
+    /// The current simulation time.
+    fn time(&self) -> T;
+
+    /// Runs until `target` (at or beyond the current time in the run's direction),
+    /// passing every collision to `observer` in time order and calling its `progress`
+    /// now and then. Collisions exactly at `target` are processed before returning.
+    /// How a run is cut into `advance_to` calls does not change its trajectory.
+    ///
+    /// # Errors
+    /// A [`SimError`] if the engine cannot continue exactly (the state is left at the
+    /// time of the failure).
+    fn advance_to(&mut self, target: T, observer: &mut dyn Observer<T>) -> Result<(), SimError>;
+
+    /// Writes the state of every ball at the current time into `out`.
+    fn states(&self, out: &mut BallStates<T, D>);
+
+    /// The collisions so far.
+    fn counters(&self) -> Counters;
+}

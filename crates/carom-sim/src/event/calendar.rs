@@ -1,0 +1,458 @@
+//! The event calendar: one scheduled event per ball, ordered by time.
+//!
+//! The event-driven engine keeps at most one pending event per ball (its earliest
+//! predicted event), so the calendar maps ball index → time and must support
+//! "schedule or reschedule ball i at t", "cancel ball i" and "pop the earliest".
+//!
+//! It follows Paul (J. Comput. Phys. 221, 2007): time is cut into buckets of width `w`,
+//! and `nb` consecutive buckets form a *cycle*. Events in the current bucket live in a
+//! small binary min-heap; events in the rest of the cycle live in unsorted
+//! doubly-linked lists (one per bucket, O(1) insert and remove); events beyond the cycle
+//! live in an unsorted overflow list. Popping takes from the heap; when it runs dry the
+//! cursor moves to the next non-empty bucket, whose list is heapified. When the cycle is
+//! used up the next one starts and the overflow is redistributed — once per cycle, so
+//! each event is looked at O(1) times per cycle. With `w` chosen so a bucket holds a few
+//! events, scheduling and popping cost O(1) on average plus a heap of a handful of
+//! entries, instead of O(log N) in one big heap.
+//!
+//! Ties are broken by ball index, so the order of events is deterministic.
+
+use carom_math::{Real, floor_to_i64};
+
+const NONE: u32 = u32::MAX;
+
+/// Where a ball's event is stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Slot {
+    /// No event scheduled.
+    Idle,
+    /// In the heap at this position.
+    Heap(u32),
+    /// In the list of this bucket (index into `heads`).
+    Bucket(u32),
+    /// In the overflow list at this position.
+    Overflow(u32),
+}
+
+/// A calendar of at most one event per ball.
+#[derive(Clone, Debug)]
+pub struct Calendar<T: Real> {
+    time: Vec<T>,
+    slot: Vec<Slot>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    heads: Vec<u32>,
+    heap: Vec<u32>,
+    overflow: Vec<u32>,
+    /// The inverse of the bucket width.
+    inv_width: T,
+    /// Absolute index of the bucket the heap holds (bucket k spans `[k w, (k+1) w)`).
+    current: i64,
+    /// The first bucket after the current cycle: lists hold buckets in
+    /// `(current, cycle_end)`, the overflow holds buckets `>= cycle_end`.
+    cycle_end: i64,
+    len: usize,
+}
+
+impl<T: Real> Calendar<T> {
+    /// An empty calendar for `balls` balls, with `buckets` buckets of width `width`
+    /// starting at time `start`. `width` must be positive and finite; `buckets >= 1`.
+    pub fn new(balls: usize, buckets: usize, width: T, start: T) -> Self {
+        assert!(
+            width > T::zero() && width.finite(),
+            "bucket width must be positive and finite"
+        );
+        assert!(balls < NONE as usize, "at most 2^32 − 2 balls");
+        let buckets = buckets.max(1);
+        let mut c = Self {
+            time: vec![T::INFINITY; balls],
+            slot: vec![Slot::Idle; balls],
+            next: vec![NONE; balls],
+            prev: vec![NONE; balls],
+            heads: vec![NONE; buckets],
+            heap: Vec::with_capacity(64),
+            overflow: Vec::new(),
+            inv_width: T::one() / width,
+            current: 0,
+            cycle_end: 0,
+            len: 0,
+        };
+        c.current = c.bucket_of(start);
+        c.cycle_end = c.current.saturating_add(buckets as i64);
+        c
+    }
+
+    /// A bucket width and count for `balls` balls whose events are spread over about
+    /// `horizon` (e.g. the mean time between a ball's events): about eight events per
+    /// bucket, buckets spanning a few horizons.
+    pub fn sized_for(balls: usize, horizon: T, start: T) -> Self {
+        let n = T::from_count(balls.max(1));
+        let width = if horizon > T::zero() && horizon.finite() {
+            horizon * T::lit(8.0) / n
+        } else {
+            T::one()
+        };
+        let buckets = (balls / 2).next_power_of_two().clamp(16, 1 << 20);
+        Self::new(balls, buckets, width.max(T::MIN_POSITIVE), start)
+    }
+
+    /// The number of scheduled events.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// `true` if nothing is scheduled.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The time of `ball`'s event, or infinity.
+    pub fn time_of(&self, ball: usize) -> T {
+        self.time[ball]
+    }
+
+    fn bucket_of(&self, t: T) -> i64 {
+        // Saturating: times far beyond the range land in the overflow list.
+        floor_to_i64(t * self.inv_width)
+    }
+
+    /// Schedules `ball` at time `t`, replacing its previous event. An infinite `t` cancels.
+    pub fn schedule(&mut self, ball: usize, t: T) {
+        self.cancel(ball);
+        if t == T::INFINITY {
+            return;
+        }
+        debug_assert!(t.finite(), "event times are finite or +infinity");
+        self.time[ball] = t;
+        self.len += 1;
+        self.place(ball as u32);
+    }
+
+    /// Removes `ball`'s event, if any.
+    pub fn cancel(&mut self, ball: usize) {
+        match self.slot[ball] {
+            Slot::Idle => return,
+            Slot::Heap(pos) => self.heap_remove(pos as usize),
+            Slot::Bucket(b) => self.list_remove(ball as u32, b as usize),
+            Slot::Overflow(pos) => {
+                let pos = pos as usize;
+                self.overflow.swap_remove(pos);
+                if let Some(&moved) = self.overflow.get(pos) {
+                    self.slot[moved as usize] = Slot::Overflow(pos as u32);
+                }
+            }
+        }
+        self.slot[ball] = Slot::Idle;
+        self.time[ball] = T::INFINITY;
+        self.len -= 1;
+    }
+
+    /// The earliest event `(ball, time)` without removing it.
+    pub fn peek(&mut self) -> Option<(usize, T)> {
+        self.refill();
+        self.heap
+            .first()
+            .map(|&b| (b as usize, self.time[b as usize]))
+    }
+
+    /// Removes and returns the earliest event `(ball, time)`; ties go to the lower ball.
+    pub fn pop(&mut self) -> Option<(usize, T)> {
+        let (ball, t) = self.peek()?;
+        self.cancel(ball);
+        Some((ball, t))
+    }
+
+    /// Puts a ball whose time is set into the heap, a bucket or the overflow list.
+    fn place(&mut self, ball: u32) {
+        let k = self.bucket_of(self.time[ball as usize]);
+        if k <= self.current {
+            self.heap_push(ball);
+        } else if k < self.cycle_end {
+            self.list_push(ball, k.rem_euclid(self.heads.len() as i64) as usize);
+        } else {
+            self.slot[ball as usize] = Slot::Overflow(self.overflow.len() as u32);
+            self.overflow.push(ball);
+        }
+    }
+
+    /// Moves the cursor forward until the heap holds the earliest events.
+    ///
+    /// Invariant: heap events are in buckets `<= current`, list events in
+    /// `(current, cycle_end)`, overflow events in `>= cycle_end`.
+    fn refill(&mut self) {
+        if !self.heap.is_empty() || self.len == 0 {
+            return;
+        }
+        let nb = self.heads.len() as i64;
+        loop {
+            let mut k = self.current + 1;
+            while k < self.cycle_end {
+                let b = k.rem_euclid(nb) as usize;
+                if self.heads[b] != NONE {
+                    self.current = k;
+                    self.drain_bucket_into_heap(b);
+                    return;
+                }
+                k += 1;
+            }
+            // The cycle is used up: the next one starts at the earliest overflow event
+            // (skipping empty cycles), and the overflow is redistributed once.
+            let earliest = self
+                .overflow
+                .iter()
+                .map(|&b| self.time[b as usize])
+                .fold(T::INFINITY, T::min);
+            debug_assert!(
+                earliest < T::INFINITY,
+                "events are counted but none is stored"
+            );
+            self.current = self.bucket_of(earliest).max(self.cycle_end);
+            self.cycle_end = self.current.saturating_add(nb);
+            self.redistribute_overflow();
+            if !self.heap.is_empty() {
+                return;
+            }
+        }
+    }
+
+    fn drain_bucket_into_heap(&mut self, b: usize) {
+        let mut ball = self.heads[b];
+        self.heads[b] = NONE;
+        while ball != NONE {
+            let next = self.next[ball as usize];
+            self.next[ball as usize] = NONE;
+            self.prev[ball as usize] = NONE;
+            self.heap_push(ball);
+            ball = next;
+        }
+    }
+
+    /// Places every overflow event again relative to the current cycle.
+    fn redistribute_overflow(&mut self) {
+        let pending = std::mem::take(&mut self.overflow);
+        for &ball in &pending {
+            self.place(ball);
+        }
+        // Keep the allocation when every event left the overflow.
+        if self.overflow.is_empty() {
+            self.overflow = pending;
+            self.overflow.clear();
+        }
+    }
+
+    fn list_push(&mut self, ball: u32, b: usize) {
+        let head = self.heads[b];
+        self.next[ball as usize] = head;
+        self.prev[ball as usize] = NONE;
+        if head != NONE {
+            self.prev[head as usize] = ball;
+        }
+        self.heads[b] = ball;
+        self.slot[ball as usize] = Slot::Bucket(b as u32);
+    }
+
+    fn list_remove(&mut self, ball: u32, b: usize) {
+        let (p, n) = (self.prev[ball as usize], self.next[ball as usize]);
+        if p == NONE {
+            self.heads[b] = n;
+        } else {
+            self.next[p as usize] = n;
+        }
+        if n != NONE {
+            self.prev[n as usize] = p;
+        }
+        self.next[ball as usize] = NONE;
+        self.prev[ball as usize] = NONE;
+    }
+
+    /// `true` if `a` comes before `b`: earlier time, then lower index.
+    #[inline]
+    fn before(&self, a: u32, b: u32) -> bool {
+        let (ta, tb) = (self.time[a as usize], self.time[b as usize]);
+        ta < tb || (ta == tb && a < b)
+    }
+
+    fn heap_push(&mut self, ball: u32) {
+        self.heap.push(ball);
+        let pos = self.heap.len() - 1;
+        self.slot[ball as usize] = Slot::Heap(pos as u32);
+        self.sift_up(pos);
+    }
+
+    fn heap_remove(&mut self, pos: usize) {
+        let last = self.heap.len() - 1;
+        if pos == last {
+            self.heap.pop();
+        } else {
+            self.heap.swap(pos, last);
+            let moved = self.heap[pos];
+            self.slot[moved as usize] = Slot::Heap(pos as u32);
+            self.heap.pop();
+            let pos = self.sift_up(pos);
+            self.sift_down(pos);
+        }
+    }
+
+    fn sift_up(&mut self, mut pos: usize) -> usize {
+        while pos > 0 {
+            let parent = (pos - 1) / 2;
+            if !self.before(self.heap[pos], self.heap[parent]) {
+                break;
+            }
+            self.swap_heap(pos, parent);
+            pos = parent;
+        }
+        pos
+    }
+
+    fn sift_down(&mut self, mut pos: usize) {
+        loop {
+            let (l, r) = (2 * pos + 1, 2 * pos + 2);
+            let mut best = pos;
+            if l < self.heap.len() && self.before(self.heap[l], self.heap[best]) {
+                best = l;
+            }
+            if r < self.heap.len() && self.before(self.heap[r], self.heap[best]) {
+                best = r;
+            }
+            if best == pos {
+                return;
+            }
+            self.swap_heap(pos, best);
+            pos = best;
+        }
+    }
+
+    fn swap_heap(&mut self, a: usize, b: usize) {
+        self.heap.swap(a, b);
+        self.slot[self.heap[a] as usize] = Slot::Heap(a as u32);
+        self.slot[self.heap[b] as usize] = Slot::Heap(b as u32);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::collections::BTreeSet;
+
+    /// The oracle: an ordered set of (time bits, ball) with a map ball → time.
+    #[derive(Default)]
+    struct Oracle {
+        set: BTreeSet<(u64, usize)>,
+        time: std::collections::HashMap<usize, f64>,
+    }
+
+    impl Oracle {
+        fn key(t: f64) -> u64 {
+            // Non-negative finite times order like their bit patterns.
+            t.to_bits()
+        }
+        fn schedule(&mut self, ball: usize, t: f64) {
+            self.cancel(ball);
+            if t.is_finite() {
+                self.set.insert((Self::key(t), ball));
+                self.time.insert(ball, t);
+            }
+        }
+        fn cancel(&mut self, ball: usize) {
+            if let Some(t) = self.time.remove(&ball) {
+                self.set.remove(&(Self::key(t), ball));
+            }
+        }
+        fn pop(&mut self) -> Option<(usize, f64)> {
+            let &(k, ball) = self.set.iter().next()?;
+            self.set.remove(&(k, ball));
+            self.time.remove(&ball);
+            Some((ball, f64::from_bits(k)))
+        }
+    }
+
+    #[derive(Clone, Debug)]
+    enum Op {
+        Schedule(usize, f64),
+        Cancel(usize),
+        Pop,
+    }
+
+    fn ops() -> impl Strategy<Value = Vec<Op>> {
+        let op = prop_oneof![
+            4 => (0..40usize, 0.0..5.0f64).prop_map(|(b, dt)| Op::Schedule(b, dt)),
+            // far in the future: exercises the overflow list
+            1 => (0..40usize, 5.0..1e6f64).prop_map(|(b, dt)| Op::Schedule(b, dt)),
+            // coincident times: exercises tie-breaking
+            1 => (0..40usize).prop_map(|b| Op::Schedule(b, 0.0)),
+            1 => (0..40usize).prop_map(Op::Cancel),
+            3 => Just(Op::Pop),
+        ];
+        proptest::collection::vec(op, 1..400)
+    }
+
+    proptest! {
+        #[test]
+        fn pops_in_the_same_order_as_an_ordered_set(ops in ops(), width in 0.001..2.0f64, buckets in 1..64usize) {
+            let mut cal = Calendar::<f64>::new(40, buckets, width, 0.0);
+            let mut oracle = Oracle::default();
+            let mut now = 0.0f64;
+            for op in ops {
+                match op {
+                    // Events are never scheduled before the current time.
+                    Op::Schedule(b, dt) => { cal.schedule(b, now + dt); oracle.schedule(b, now + dt); }
+                    Op::Cancel(b) => { cal.cancel(b); oracle.cancel(b); }
+                    Op::Pop => {
+                        let got = cal.pop();
+                        prop_assert_eq!(got, oracle.pop());
+                        if let Some((_, t)) = got { now = t; }
+                    }
+                }
+                prop_assert_eq!(cal.len(), oracle.set.len());
+            }
+            while let Some(e) = cal.pop() {
+                prop_assert_eq!(Some(e), oracle.pop());
+            }
+            prop_assert!(oracle.pop().is_none());
+        }
+    }
+
+    #[test]
+    fn rescheduling_replaces_and_infinity_cancels() {
+        let mut c = Calendar::<f32>::sized_for(3, 1.0, 0.0);
+        c.schedule(0, 2.0);
+        c.schedule(1, 1.0);
+        c.schedule(0, 0.5);
+        c.schedule(2, 3.0);
+        c.schedule(2, f32::INFINITY);
+        assert_eq!(c.len(), 2);
+        assert_eq!(c.pop(), Some((0, 0.5)));
+        assert_eq!(c.pop(), Some((1, 1.0)));
+        assert_eq!(c.pop(), None);
+    }
+
+    #[test]
+    fn an_overflow_event_comes_before_a_later_bucket_once_the_window_reaches_it() {
+        // 4 buckets of width 1. Ball 0 at t = 5.5 starts in the overflow (bucket 5 >= 0 + 4).
+        // After popping t = 2.5, the window is (2, 6): ball 0 must pop before ball 1 at 5.9,
+        // which was scheduled into a bucket list after the cursor moved.
+        let mut c = Calendar::<f64>::new(3, 4, 1.0, 0.0);
+        c.schedule(0, 5.5);
+        c.schedule(2, 2.5);
+        assert_eq!(c.pop(), Some((2, 2.5)));
+        c.schedule(1, 5.9);
+        assert_eq!(c.pop(), Some((0, 5.5)));
+        assert_eq!(c.pop(), Some((1, 5.9)));
+    }
+
+    #[test]
+    fn huge_times_wait_in_the_overflow_and_come_back_in_order() {
+        let mut c = Calendar::<f64>::new(4, 8, 1e-3, 0.0);
+        c.schedule(3, 1e300);
+        c.schedule(2, 1e9);
+        c.schedule(1, 0.0105);
+        c.schedule(0, 1e9);
+        assert_eq!(c.pop(), Some((1, 0.0105)));
+        assert_eq!(c.pop(), Some((0, 1e9)));
+        assert_eq!(c.pop(), Some((2, 1e9)));
+        assert_eq!(c.pop(), Some((3, 1e300)));
+        assert!(c.is_empty());
+    }
+}

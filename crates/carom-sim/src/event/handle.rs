@@ -1,0 +1,330 @@
+//! Processing events: what happens when a ball's pending event comes due.
+//!
+//! A collision synchronises the balls involved to the event time, builds the two
+//! carom-response bodies and their contact, applies the impulse, counts it, tells the
+//! observer, and re-predicts the balls whose motion changed. A stale event (the partner
+//! collided since it was predicted) only re-predicts. Restitution passes through the
+//! guards first: the TC model for ball–ball collisions, the resting guard for bounces on
+//! a surface that gravity presses the ball onto.
+
+use carom_geometry::query::PointQuery;
+use carom_math::{Real, Space, Vector};
+use carom_response::{Body, Bounce, Coefficients, Contact, normal_velocity, resolve};
+use nalgebra::Const;
+
+use super::state::{Mode, Support};
+use super::{EventEngine, Partners, Pending};
+use crate::engine::{Collision, Observer, SimError};
+
+impl<T: Real, const D: usize> EventEngine<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Processes the pending event of calendar slot `i` (a ball, or a cluster after the
+    /// balls) at the current time.
+    pub(crate) fn handle(
+        &mut self,
+        i: usize,
+        observer: &mut dyn Observer<T>,
+    ) -> Result<(), SimError> {
+        let now = self.now;
+        if i >= self.balls.len() {
+            return self.handle_cluster(i - self.balls.len(), observer);
+        }
+        match self.pending[i] {
+            Pending::None => {}
+            Pending::Recheck => self.predict(i),
+            Pending::Cluster { c, count } => {
+                let c = c as usize;
+                if self.clusters[c].alive && self.clusters[c].count == count {
+                    self.ball_meets_cluster(i, c, observer)?;
+                } else {
+                    self.predict(i);
+                }
+            }
+            Pending::Rebuild => {
+                let periodic = self.periodic_border().copied();
+                self.balls.sync(i, now, periodic.as_ref());
+                if let Partners::Lists(lists) = &mut self.partners {
+                    lists.rebuild(i, self.balls.pos[i]);
+                }
+                self.predict(i);
+            }
+            Pending::LeaveSupport => {
+                self.sync_ball(i);
+                self.free(i);
+                self.predict(i);
+            }
+            Pending::Ball { j, count } => {
+                let j = j as usize;
+                if self.balls.count[j] != count || matches!(self.balls.mode[j], Mode::Stuck(_)) {
+                    self.predict(i);
+                } else if self.sticks(i, j) {
+                    self.sync_ball(i);
+                    self.sync_ball(j);
+                    let c = self.stick_balls(i, j)?;
+                    self.counters.ball_ball += 1;
+                    observer.collision(&Collision::BallBall {
+                        time: self.now * self.sign,
+                        i: i.min(j),
+                        j: i.max(j),
+                    });
+                    self.predict_cluster(c);
+                } else {
+                    self.collide_balls(i, j, observer);
+                    self.predict(i);
+                    self.predict(j);
+                }
+            }
+            Pending::Wall { axis, upper } => {
+                self.collide_wall(i, axis as usize, upper, observer);
+                self.predict(i);
+            }
+            Pending::Box { k } => {
+                self.collide_box(i, k as usize, observer);
+                self.predict(i);
+            }
+        }
+        Ok(())
+    }
+
+    /// `true` if balls `i` and `j` stick: restitution 0 in a "stick" world.
+    fn sticks(&self, i: usize, j: usize) -> bool {
+        self.stick && self.ball_restitution(i).min(self.ball_restitution(j)) == T::zero()
+    }
+
+    pub(crate) fn sync_ball(&mut self, i: usize) {
+        let periodic = self.periodic_border().copied();
+        self.balls.sync(i, self.now, periodic.as_ref());
+    }
+
+    /// Ball `i` as a carom-response body (synchronised).
+    pub(crate) fn ball_body(&self, i: usize) -> Body<T, D> {
+        let (m, r) = (self.balls.mass[i], self.balls.radius[i]);
+        let inertia = <Const<D> as Space<T, D>>::ball_inertia_factor() * m * r * r;
+        Body::new_unchecked(
+            T::one() / m,
+            <Const<D> as Space<T, D>>::inertia_isotropic(T::one() / inertia),
+            self.balls.vel[i],
+            self.balls.spin[i],
+        )
+    }
+
+    /// A ball's trajectory changed: count it (invalidating events predicted with it)
+    /// and remember when, for the collapse guard.
+    fn changed(&mut self, i: usize) {
+        self.balls.count[i] = self.balls.count[i].wrapping_add(1);
+        self.balls.last_collision[i] = self.now;
+    }
+
+    /// Ball `i` flies freely again under gravity.
+    fn free(&mut self, i: usize) {
+        if let Mode::Resting(_) = self.balls.mode[i] {
+            self.balls.mode[i] = Mode::Free;
+            self.balls.accel[i] = self.gravity;
+            self.balls.count[i] = self.balls.count[i].wrapping_add(1);
+        }
+    }
+
+    /// After an impulse on a resting ball: it stays resting only if its velocity along the
+    /// support normal still matches the support's; otherwise it flies (and if it now
+    /// presses into the support, the next prediction finds that contact at once).
+    fn check_support(&mut self, i: usize) {
+        let Mode::Resting(support) = self.balls.mode[i] else {
+            return;
+        };
+        let (n, support_velocity) = self.support_frame(support);
+        if (self.balls.vel[i] - support_velocity).dot(&n) != T::zero() {
+            self.free(i);
+        }
+    }
+
+    /// The unit normal into the support and the support's velocity.
+    fn support_frame(&self, support: Support) -> (Vector<T, D>, Vector<T, D>) {
+        match support {
+            Support::Wall { axis, upper } => {
+                let mut n = Vector::<T, D>::zeros();
+                n[axis] = if upper { T::one() } else { -T::one() };
+                (n, Vector::zeros())
+            }
+            Support::BoxFace { k, axis, upper } => {
+                let b = &self.boxes[k];
+                let mut local = Vector::<T, D>::zeros();
+                // Into the box: against the face's outward normal.
+                local[axis] = if upper { -T::one() } else { T::one() };
+                (b.shape.vector_to_world(&local), b.vel)
+            }
+        }
+    }
+
+    fn collide_balls(&mut self, i: usize, j: usize, observer: &mut dyn Observer<T>) {
+        self.sync_ball(i);
+        self.sync_ball(j);
+        let ci = self.balls.pos[i];
+        let cj = ci + self.separation(&ci, &self.balls.pos[j]);
+        let (ri, rj) = (self.balls.radius[i], self.balls.radius[j]);
+        let Ok(contact) = Contact::between_balls(&ci, ri, &cj, rj) else {
+            // Coincident centres cannot come from a predicted contact of positive radii.
+            return;
+        };
+        let (a, b) = (self.ball_body(i), self.ball_body(j));
+        let approach = -normal_velocity(&a, &b, &contact);
+        let nominal = self.ball_restitution(i).min(self.ball_restitution(j));
+        let since = [
+            self.now - self.balls.last_collision[i],
+            self.now - self.balls.last_collision[j],
+        ];
+        let e = self.collapse.restitution(nominal, approach, since);
+        let response = resolve(
+            &a,
+            &b,
+            &contact,
+            &Coefficients::new_unchecked(e, self.friction),
+        );
+        if !response.applied() {
+            return;
+        }
+        self.balls.vel[i] = response.velocity[0];
+        self.balls.vel[j] = response.velocity[1];
+        // Without friction the impulse is central and cannot spin a ball; keeping the spin
+        // as it is avoids the rounding of r × n (1e-17, not exactly 0).
+        if self.friction > T::zero() {
+            self.balls.spin[i] = response.angular_velocity[0];
+            self.balls.spin[j] = response.angular_velocity[1];
+        }
+        self.changed(i);
+        self.changed(j);
+        self.check_support(i);
+        self.check_support(j);
+        self.counters.ball_ball += 1;
+        observer.collision(&Collision::BallBall {
+            time: self.now * self.sign,
+            i: i.min(j),
+            j: i.max(j),
+        });
+    }
+
+    /// The ball's restitution in ball–ball collisions: its own or the world's.
+    pub(crate) fn ball_restitution(&self, i: usize) -> T {
+        self.balls.restitution[i].unwrap_or(self.world_restitution)
+    }
+
+    /// The restitution of ball `i` against a surface of restitution `surface`: the
+    /// minimum of the ball's own value (if it has one) and the surface's.
+    pub(crate) fn surface_restitution(&self, i: usize, surface: T) -> T {
+        self.balls.restitution[i].map_or(surface, |e| e.min(surface))
+    }
+
+    /// A bounce of ball `i` on an immovable surface moving at `surface_velocity`, along
+    /// `normal` (from the ball into the surface), touching at `point`. Returns `true` if
+    /// an impulse was applied; `support` is where the ball rests if the guard says so.
+    fn bounce(
+        &mut self,
+        i: usize,
+        normal: Vector<T, D>,
+        point: Vector<T, D>,
+        surface_velocity: Vector<T, D>,
+        surface_restitution: T,
+        support: Option<Support>,
+    ) -> bool {
+        let r = self.balls.radius[i];
+        let contact =
+            Contact::new_unchecked(normal, normal * r, point - self.balls.pos[i] - normal * r);
+        let a = self.ball_body(i);
+        let b = Body::kinematic(surface_velocity, <Const<D> as Space<T, D>>::angular_zero())
+            .unwrap_or_else(|_| Body::fixed());
+        let approach = -normal_velocity(&a, &b, &contact);
+        let mut e = self.surface_restitution(i, surface_restitution);
+        let pressing = self.gravity.dot(&normal);
+        let rest = support.is_some() && self.resting.decide(approach, e, pressing) == Bounce::Rest;
+        if rest {
+            e = T::zero();
+        }
+        let response = resolve(
+            &a,
+            &b,
+            &contact,
+            &Coefficients::new_unchecked(e, self.friction),
+        );
+        if !response.applied() {
+            return false;
+        }
+        self.balls.vel[i] = response.velocity[0];
+        if self.friction > T::zero() {
+            self.balls.spin[i] = response.angular_velocity[0];
+        }
+        self.changed(i);
+        if let (true, Some(s)) = (rest, support) {
+            // Rest exactly: no normal velocity relative to the surface, no normal
+            // acceleration; gravity's tangential part still drives the ball.
+            let v = self.balls.vel[i];
+            self.balls.vel[i] = v - normal * (v - surface_velocity).dot(&normal);
+            self.balls.accel[i] = self.gravity - normal * pressing;
+            self.balls.mode[i] = Mode::Resting(s);
+        } else {
+            self.check_support(i);
+        }
+        true
+    }
+
+    fn collide_wall(&mut self, i: usize, axis: usize, upper: bool, observer: &mut dyn Observer<T>) {
+        self.sync_ball(i);
+        let Some(border) = self.border else { return };
+        let mut normal = Vector::<T, D>::zeros();
+        normal[axis] = if upper { T::one() } else { -T::one() };
+        let mut point = self.balls.pos[i];
+        point[axis] = if upper {
+            border.max()[axis]
+        } else {
+            border.min()[axis]
+        };
+        let support = Some(Support::Wall { axis, upper });
+        if self.bounce(
+            i,
+            normal,
+            point,
+            Vector::zeros(),
+            self.border_restitution,
+            support,
+        ) {
+            self.counters.ball_border += 1;
+            observer.collision(&Collision::BallBorder {
+                time: self.now * self.sign,
+                i,
+            });
+        }
+    }
+
+    fn collide_box(&mut self, i: usize, k: usize, observer: &mut dyn Observer<T>) {
+        self.sync_ball(i);
+        let b = self.boxes[k];
+        let obb = b.at(self.now);
+        let centre = self.balls.pos[i];
+        let image = obb.center() - self.separation(&centre, &obb.center());
+        let boundary = obb.boundary_point(&image);
+        // Work in the image's frame, then shift the contact point back to the ball.
+        let normal = -boundary.normal;
+        let point = boundary.point + (centre - image);
+        // The face the ball touches, if it touches a face (not an edge or a corner):
+        // only a face can hold a resting ball.
+        let local = obb.to_local(&image);
+        let h = obb.half_extents();
+        let mut outside = (0usize, 0usize);
+        for m in (0..D).filter(|&m| local[m].abs() > h[m]) {
+            outside = (outside.0 + 1, m);
+        }
+        let support = (outside.0 == 1).then(|| Support::BoxFace {
+            k,
+            axis: outside.1,
+            upper: local[outside.1] > T::zero(),
+        });
+        if self.bounce(i, normal, point, b.vel, b.restitution, support) {
+            self.counters.ball_box += 1;
+            observer.collision(&Collision::BallBox {
+                time: self.now * self.sign,
+                i,
+                k,
+            });
+        }
+    }
+}

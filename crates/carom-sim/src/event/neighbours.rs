@@ -1,0 +1,470 @@
+//! Neighbour lists with a shell, the event-driven engine's way to find partners fast.
+//!
+//! Each ball `i` has an *anchor* `aᵢ` (its position when its list was last built) and a
+//! shell `δ`. The list of `i` holds every `j` with `|aᵢ − aⱼ| < rᵢ + rⱼ + 2δ`. As long as
+//! every ball stays within `δ` of its anchor, two balls that touch have
+//! `|aᵢ − aⱼ| <= |xᵢ − xⱼ| + 2δ = rᵢ + rⱼ + 2δ`, so they are on each other's lists: only
+//! list partners can collide. A ball rebuilds its list (a scheduled event) when it is
+//! about to leave its shell; the relation is symmetric, so a rebuild also adds the ball
+//! to its new partners' lists and removes it from the old ones (Smallenburg, J. Chem.
+//! Phys. 2022, "Efficient event-driven simulations of hard spheres").
+//!
+//! Anchors are binned in a grid of cells at least `2 r_max + 2δ` wide, so a rebuild only
+//! looks at the `3^D` cells around the anchor. Bounded domains (walls or periodic) index
+//! cells directly (wrapping for periodic); unbounded ones hash the integer cell
+//! coordinates into a table of about `2N` heads. Candidates met twice (hash clashes,
+//! fewer than 3 cells per periodic axis) are skipped with a per-ball stamp.
+//!
+//! Very mixed radii make the cells (sized by the largest ball) hold many small balls;
+//! the lists stay exact, only rebuilds get slower.
+
+use carom_geometry::Border;
+use carom_math::{Real, Vector, floor_to_i64};
+
+const NONE: u32 = u32::MAX;
+
+/// The domain the anchors live in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Domain<T: Real, const D: usize> {
+    /// A box `[min, max]` that balls never leave (reflecting walls).
+    Bounded {
+        /// Lower corner.
+        min: Vector<T, D>,
+        /// Upper corner.
+        max: Vector<T, D>,
+    },
+    /// A periodic box: separations use the minimum image.
+    Periodic {
+        /// Lower corner.
+        min: Vector<T, D>,
+        /// Upper corner.
+        max: Vector<T, D>,
+    },
+    /// No container.
+    Unbounded,
+}
+
+/// How anchors map to cell heads.
+#[derive(Clone, Debug)]
+enum Cells<T: Real, const D: usize> {
+    /// Direct indexing into a `counts[0] × … × counts[D−1]` array.
+    Direct {
+        origin: Vector<T, D>,
+        counts: [i64; D],
+        periodic: bool,
+    },
+    /// Hashed integer coordinates into `heads.len()` (a power of two) buckets.
+    Hashed,
+}
+
+/// Symmetric neighbour lists over anchored balls.
+#[derive(Clone, Debug)]
+pub struct NeighbourLists<T: Real, const D: usize> {
+    shell: T,
+    /// Inverse cell width per axis (periodic axes are tiled exactly by their cells).
+    inv_cell: Vector<T, D>,
+    cells: Cells<T, D>,
+    /// The periodic box, for minimum images.
+    period: Option<Border<T, D>>,
+    heads: Vec<u32>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    cell_of: Vec<u32>,
+    anchor: Vec<Vector<T, D>>,
+    radius: Vec<T>,
+    lists: Vec<Vec<u32>>,
+    stamp: Vec<u32>,
+    current_stamp: u32,
+}
+
+impl<T: Real, const D: usize> NeighbourLists<T, D> {
+    /// Lists for balls at `positions` with `radii`, shell `shell > 0`, in `domain`.
+    /// Every ball's anchor is its current position.
+    pub fn new(positions: &[Vector<T, D>], radii: &[T], shell: T, domain: Domain<T, D>) -> Self {
+        assert_eq!(positions.len(), radii.len());
+        assert!(
+            shell > T::zero() && shell.finite(),
+            "shell must be positive"
+        );
+        let n = positions.len();
+        let r_max = radii.iter().copied().fold(T::zero(), T::max);
+        let mut cell = (r_max + shell) * T::lit(2.0);
+        let (cells, period, table, width) = match domain {
+            Domain::Bounded { min, max } | Domain::Periodic { min, max } => {
+                let periodic = matches!(domain, Domain::Periodic { .. });
+                let ext = max - min;
+                // Cap the table near 4N cells by widening cells in sparse boxes.
+                let budget = T::from_count((4 * n).max(64));
+                let needed = (ext.product() / budget).powf(T::one() / T::from_count(D));
+                cell = cell.max(needed);
+                let counts: [i64; D] =
+                    core::array::from_fn(|k| ((ext[k] / cell).floor().to_f64() as i64).max(1));
+                // Each axis is cut into whole cells, each at least `cell` wide: on a
+                // periodic axis a partial last cell would break the wrap-around.
+                let width =
+                    Vector::<T, D>::from_fn(|k, _| ext[k] / T::from_count(counts[k] as usize));
+                let total: i64 = counts.iter().product();
+                (
+                    Cells::Direct {
+                        origin: min,
+                        counts,
+                        periodic,
+                    },
+                    periodic
+                        .then(|| Border::new(min, max).expect("a periodic domain is a valid box")),
+                    total as usize,
+                    width,
+                )
+            }
+            Domain::Unbounded => (
+                Cells::Hashed,
+                None,
+                (2 * n).next_power_of_two().max(64),
+                Vector::repeat(cell),
+            ),
+        };
+        let mut lists = Self {
+            shell,
+            inv_cell: width.map(|w| T::one() / w),
+            cells,
+            period,
+            heads: vec![NONE; table],
+            next: vec![NONE; n],
+            prev: vec![NONE; n],
+            cell_of: vec![NONE; n],
+            anchor: positions.to_vec(),
+            radius: radii.to_vec(),
+            lists: vec![Vec::new(); n],
+            stamp: vec![0; n],
+            current_stamp: 0,
+        };
+        for i in 0..n {
+            let c = lists.cell_index(&lists.anchor[i]);
+            lists.insert_in_cell(i as u32, c);
+        }
+        for i in 0..n {
+            lists.collect_partners(i, true);
+        }
+        lists
+    }
+
+    /// The shell width `δ`.
+    pub fn shell(&self) -> T {
+        self.shell
+    }
+
+    /// The anchor of ball `i`.
+    pub fn anchor(&self, i: usize) -> &Vector<T, D> {
+        &self.anchor[i]
+    }
+
+    /// The partners of ball `i`.
+    pub fn partners(&self, i: usize) -> &[u32] {
+        &self.lists[i]
+    }
+
+    /// The separation `b − a`, as the minimum image in a periodic domain.
+    #[inline]
+    pub fn separation(&self, a: &Vector<T, D>, b: &Vector<T, D>) -> Vector<T, D> {
+        match &self.period {
+            Some(border) => border.minimum_image(&(b - a)),
+            None => b - a,
+        }
+    }
+
+    /// Re-anchors ball `i` at `position` and rebuilds its list (and its place in its
+    /// partners' lists).
+    pub fn rebuild(&mut self, i: usize, position: Vector<T, D>) {
+        let old = std::mem::take(&mut self.lists[i]);
+        for &j in &old {
+            let list = &mut self.lists[j as usize];
+            if let Some(k) = list.iter().position(|&x| x as usize == i) {
+                list.swap_remove(k);
+            }
+        }
+        self.lists[i] = old;
+        self.lists[i].clear();
+        self.remove_from_cell(i as u32);
+        self.anchor[i] = position;
+        let c = self.cell_index(&position);
+        self.insert_in_cell(i as u32, c);
+        self.collect_partners(i, false);
+    }
+
+    /// Finds the partners of `i` in the cells around its anchor. With `only_higher`
+    /// (the initial build) each pair is found once from its lower index.
+    fn collect_partners(&mut self, i: usize, only_higher: bool) {
+        self.current_stamp = self.current_stamp.wrapping_add(1);
+        if self.current_stamp == 0 {
+            self.stamp.fill(0);
+            self.current_stamp = 1;
+        }
+        self.stamp[i] = self.current_stamp;
+        let a = self.anchor[i];
+        let base = self.cell_coords(&a);
+        let two = T::lit(2.0);
+        for offset in 0..3usize.pow(D as u32) {
+            let mut rest = offset;
+            let coords: [i64; D] = core::array::from_fn(|k| {
+                let o = (rest % 3) as i64 - 1;
+                rest /= 3;
+                base[k] + o
+            });
+            let Some(c) = self.index_of(coords) else {
+                continue;
+            };
+            let mut j = self.heads[c];
+            while j != NONE {
+                let ju = j as usize;
+                let next = self.next[ju];
+                if self.stamp[ju] != self.current_stamp && (!only_higher || ju > i) {
+                    self.stamp[ju] = self.current_stamp;
+                    let reach = self.radius[i] + self.radius[ju] + two * self.shell;
+                    if self.separation(&a, &self.anchor[ju]).norm_squared() < reach * reach {
+                        self.lists[i].push(j);
+                        self.lists[ju].push(i as u32);
+                    }
+                }
+                j = next;
+            }
+        }
+    }
+
+    fn cell_coords(&self, p: &Vector<T, D>) -> [i64; D] {
+        let origin = match &self.cells {
+            Cells::Direct { origin, .. } => *origin,
+            Cells::Hashed => Vector::zeros(),
+        };
+        // Saturating casts keep far-away points finite. In a bounded domain the edge
+        // cells extend to infinity, so coordinates are clamped to the grid.
+        core::array::from_fn(|k| {
+            let c = floor_to_i64((p[k] - origin[k]) * self.inv_cell[k]);
+            match &self.cells {
+                Cells::Direct {
+                    counts,
+                    periodic: false,
+                    ..
+                } => c.clamp(0, counts[k] - 1),
+                _ => c,
+            }
+        })
+    }
+
+    /// The head index of the cell with integer coordinates `c`, or `None` outside a
+    /// bounded domain.
+    fn index_of(&self, c: [i64; D]) -> Option<usize> {
+        match &self.cells {
+            Cells::Direct {
+                counts, periodic, ..
+            } => {
+                let mut index = 0i64;
+                for k in (0..D).rev() {
+                    let mut ck = c[k];
+                    let n = counts[k];
+                    // Neighbour offsets are within one cell of the grid, so a wrap or a
+                    // clamp is one comparison (no integer division).
+                    if *periodic {
+                        if ck < 0 {
+                            ck += n;
+                        } else if ck >= n {
+                            ck -= n;
+                        }
+                        if !(0..n).contains(&ck) {
+                            ck = ck.rem_euclid(n);
+                        }
+                    } else if ck < -1 || ck > n {
+                        return None;
+                    } else {
+                        // The edge cells extend to infinity: a point just outside
+                        // (rounding) or a neighbour offset past the edge lands there.
+                        ck = ck.clamp(0, n - 1);
+                    }
+                    index = index * counts[k] + ck;
+                }
+                Some(index as usize)
+            }
+            Cells::Hashed => {
+                // FNV-style mixing of the coordinates; clashes only cost extra candidates.
+                let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+                for &x in &c {
+                    h = (h ^ (x as u64)).wrapping_mul(0x0000_0100_0000_01b3);
+                    h ^= h >> 29;
+                }
+                Some((h as usize) & (self.heads.len() - 1))
+            }
+        }
+    }
+
+    fn cell_index(&self, p: &Vector<T, D>) -> usize {
+        self.index_of(self.cell_coords(p))
+            .expect("a point's own cell always exists")
+    }
+
+    fn insert_in_cell(&mut self, i: u32, c: usize) {
+        let head = self.heads[c];
+        self.next[i as usize] = head;
+        self.prev[i as usize] = NONE;
+        if head != NONE {
+            self.prev[head as usize] = i;
+        }
+        self.heads[c] = i;
+        self.cell_of[i as usize] = c as u32;
+    }
+
+    fn remove_from_cell(&mut self, i: u32) {
+        let c = self.cell_of[i as usize] as usize;
+        let (p, n) = (self.prev[i as usize], self.next[i as usize]);
+        if p == NONE {
+            self.heads[c] = n;
+        } else {
+            self.next[p as usize] = n;
+        }
+        if n != NONE {
+            self.prev[n as usize] = p;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenes::SplitMix64;
+    use nalgebra::{Vector2, Vector3};
+    use std::collections::BTreeSet;
+
+    /// Every pair within reach, by brute force.
+    fn brute<const D: usize>(l: &NeighbourLists<f64, D>) -> BTreeSet<(usize, usize)> {
+        let n = l.anchor.len();
+        let mut s = BTreeSet::new();
+        for i in 0..n {
+            for j in i + 1..n {
+                let reach = l.radius[i] + l.radius[j] + 2.0 * l.shell;
+                if l.separation(&l.anchor[i], &l.anchor[j]).norm_squared() < reach * reach {
+                    s.insert((i, j));
+                }
+            }
+        }
+        s
+    }
+
+    fn listed<const D: usize>(l: &NeighbourLists<f64, D>) -> BTreeSet<(usize, usize)> {
+        let mut s = BTreeSet::new();
+        for i in 0..l.anchor.len() {
+            for &j in l.partners(i) {
+                let j = j as usize;
+                assert!(l.partners(j).contains(&(i as u32)), "lists are symmetric");
+                assert!(s.insert((i.min(j), i.max(j))) || i > j, "no duplicates");
+            }
+        }
+        s
+    }
+
+    fn random_points<const D: usize>(
+        n: usize,
+        side: f64,
+        seed: u64,
+    ) -> (Vec<Vector<f64, D>>, Vec<f64>) {
+        let mut g = SplitMix64::new(seed);
+        let p = (0..n)
+            .map(|_| Vector::<f64, D>::from_fn(|_, _| side * g.uniform()))
+            .collect();
+        let r = (0..n).map(|_| 0.05 + 0.2 * g.uniform()).collect();
+        (p, r)
+    }
+
+    #[test]
+    fn lists_match_brute_force_in_every_domain_after_many_rebuilds() {
+        for (domain_kind, seed) in [(0, 1u64), (1, 2), (2, 3)] {
+            let side = 6.0;
+            let (pos, rad) = random_points::<3>(300, side, seed);
+            let (lo, hi) = (Vector3::zeros(), Vector3::repeat(side));
+            let domain = match domain_kind {
+                0 => Domain::Bounded { min: lo, max: hi },
+                1 => Domain::Periodic { min: lo, max: hi },
+                _ => Domain::Unbounded,
+            };
+            let mut l = NeighbourLists::new(&pos, &rad, 0.1, domain);
+            assert_eq!(listed(&l), brute(&l), "initial build, domain {domain_kind}");
+            let mut g = SplitMix64::new(seed + 100);
+            for _ in 0..500 {
+                let i = (g.next_u64() % 300) as usize;
+                let p = Vector3::from_fn(|_, _| side * g.uniform());
+                l.rebuild(i, p);
+            }
+            assert_eq!(
+                listed(&l),
+                brute(&l),
+                "after rebuilds, domain {domain_kind}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_periodic_box_with_unequal_sides_wraps_partners_across_every_face() {
+        // Sides 6.0 × 2.3: with cells of at least 0.6 the short axis has 3 cells of 0.767,
+        // the long one 10 of 0.6. Pairs straddling each face must be found.
+        let (mut pos, rad) = random_points::<2>(200, 1.0, 5);
+        let mut g = SplitMix64::new(6);
+        for p in &mut pos {
+            *p = Vector2::new(6.0 * g.uniform(), 2.3 * g.uniform());
+        }
+        let rad: Vec<f64> = rad.iter().map(|r| r.min(0.25)).collect();
+        let l = NeighbourLists::new(
+            &pos,
+            &rad,
+            0.05,
+            Domain::Periodic {
+                min: Vector2::zeros(),
+                max: Vector2::new(6.0, 2.3),
+            },
+        );
+        assert_eq!(listed(&l), brute(&l));
+    }
+
+    #[test]
+    fn a_small_periodic_box_with_fewer_than_three_cells_finds_each_partner_once() {
+        let (pos, rad) = random_points::<2>(20, 1.5, 9);
+        let l = NeighbourLists::new(
+            &pos,
+            &rad,
+            0.05,
+            Domain::Periodic {
+                min: Vector2::zeros(),
+                max: Vector2::repeat(1.5),
+            },
+        );
+        assert_eq!(listed(&l), brute(&l));
+    }
+
+    #[test]
+    fn balls_outside_a_bounded_domain_still_find_their_partners() {
+        let pos = vec![
+            Vector2::new(-5.0, 0.5),
+            Vector2::new(-5.1, 0.5),
+            Vector2::new(0.5, 0.5),
+        ];
+        let l = NeighbourLists::new(
+            &pos,
+            &[0.1, 0.1, 0.1],
+            0.01,
+            Domain::Bounded {
+                min: Vector2::zeros(),
+                max: Vector2::repeat(3.0),
+            },
+        );
+        assert_eq!(listed(&l), brute(&l));
+        assert_eq!(l.partners(0), &[1]);
+    }
+
+    #[test]
+    fn far_away_balls_in_an_unbounded_domain_are_not_partners() {
+        let pos = vec![
+            Vector2::new(0.0, 0.0),
+            Vector2::new(1e12, 0.0),
+            Vector2::new(0.21, 0.0),
+        ];
+        let l = NeighbourLists::new(&pos, &[0.1, 0.1, 0.1], 0.01, Domain::Unbounded);
+        assert_eq!(l.partners(0), &[2]);
+        assert!(l.partners(1).is_empty());
+    }
+}

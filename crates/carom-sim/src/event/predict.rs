@@ -1,0 +1,269 @@
+//! Prediction: the earliest event of one ball.
+//!
+//! A ball's next event is the earliest of: its list rebuild (when it leaves its shell),
+//! sliding off the face it rests on, its first border wall, its first box, and its first
+//! collision with each partner. Each search is given the best time found so far as its
+//! horizon, so later candidates stop early.
+
+use carom_geometry::Ball;
+use carom_math::{Real, Space, Vector};
+use carom_toi::{Kinematics, Window, ball_ball, ball_border, ball_obb, level_crossing};
+use nalgebra::Const;
+
+use super::state::{Mode, Support};
+use super::{EventEngine, Partners, Pending};
+
+/// A rebuild is scheduled when the ball has moved this fraction of the shell, keeping a
+/// margin far above rounding so a touching pair is always on each other's lists.
+const SHELL_SAFETY: f64 = 1.0 - 1e-6;
+
+impl<T: Real, const D: usize> EventEngine<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Predicts and schedules ball `i`'s next event (balls in clusters are scheduled by
+    /// their cluster).
+    pub(crate) fn predict(&mut self, i: usize) {
+        if let Mode::Stuck(_) = self.balls.mode[i] {
+            self.pending[i] = Pending::None;
+            self.calendar.cancel(i);
+            return;
+        }
+        let mut best = self.own_event(i);
+        let ball = self.ball_at(i, self.now);
+        let kin =
+            Kinematics::new_unchecked(self.balls.velocity_at(i, self.now), self.balls.accel[i]);
+        self.offer_surfaces(&ball, &kin, &mut best);
+        if !self.clusters.is_empty() {
+            self.predict_ball_vs_clusters(i, &mut best.time, &mut best.pending);
+        }
+        self.offer_partners(i, &ball, &kin, &mut best);
+        self.pending[i] = best.pending;
+        self.calendar.schedule(i, best.time);
+    }
+
+    /// The events of ball `i` alone: leaving its neighbour-list shell, sliding off the
+    /// face it rests on.
+    fn own_event(&self, i: usize) -> Best<T> {
+        let now = self.now;
+        let mut best = Best {
+            time: T::INFINITY,
+            pending: Pending::None,
+        };
+        if let Partners::Lists(lists) = &self.partners {
+            let displacement = self.separation(lists.anchor(i), &self.balls.position_at(i, now));
+            let velocity = self.balls.velocity_at(i, now);
+            let s = exit_time(
+                &displacement,
+                &velocity,
+                &self.balls.accel[i],
+                lists.shell() * T::lit(SHELL_SAFETY),
+            );
+            best.offer(now + s, Pending::Rebuild);
+        }
+        if let Mode::Resting(Support::BoxFace { k, axis, .. }) = self.balls.mode[i]
+            && let Some(s) = self.face_exit_time(i, k, axis)
+        {
+            best.offer(now + s, Pending::LeaveSupport);
+        }
+        best
+    }
+
+    /// The first contact of a ball with a border wall or a box.
+    fn offer_surfaces(&self, ball: &Ball<T, D>, kin: &Kinematics<T, D>, best: &mut Best<T>) {
+        let now = self.now;
+        if let (Some(border), false) = (&self.border, self.periodic) {
+            let toi = ball_border(ball, kin, border, &best.window(now));
+            if let Some(s) = toi.hit_time() {
+                let upper = toi.feature.side == carom_toi::Side::Upper;
+                best.offer(
+                    now + s,
+                    Pending::Wall {
+                        axis: toi.feature.axis as u8,
+                        upper,
+                    },
+                );
+            }
+        }
+        for (k, b) in self.boxes.iter().enumerate() {
+            let obb = b.at(now);
+            // In a periodic box, the image of the ball nearest the box.
+            let image = if self.periodic {
+                Ball::new_unchecked(
+                    obb.center() - self.separation(&ball.center(), &obb.center()),
+                    ball.radius(),
+                )
+            } else {
+                *ball
+            };
+            let toi = ball_obb(
+                &image,
+                kin,
+                &obb,
+                &Kinematics::new_unchecked(b.vel, Vector::zeros()),
+                &best.window(now),
+            );
+            if let Some(s) = toi.hit_time() {
+                best.offer(now + s, Pending::Box { k: k as u32 });
+            }
+        }
+    }
+
+    /// The first collision of ball `i` with each of its partners.
+    fn offer_partners(
+        &self,
+        i: usize,
+        ball: &Ball<T, D>,
+        kin: &Kinematics<T, D>,
+        best: &mut Best<T>,
+    ) {
+        let now = self.now;
+        let periodic = self.periodic_border();
+        let centre = ball.center();
+        let mut consider = |j: usize| {
+            if j == i || matches!(self.balls.mode[j], Mode::Stuck(_)) {
+                return;
+            }
+            let d = self.balls.position_at(j, now) - centre;
+            let d = match periodic {
+                Some(border) => border.minimum_image(&d),
+                None => d,
+            };
+            let other = Ball::new_unchecked(centre + d, self.balls.radius[j]);
+            let kin_j =
+                Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel[j]);
+            if let Some(s) = ball_ball(ball, kin, &other, &kin_j, &best.window(now)).hit_time() {
+                best.offer(
+                    now + s,
+                    Pending::Ball {
+                        j: j as u32,
+                        count: self.balls.count[j],
+                    },
+                );
+            }
+        };
+        match &self.partners {
+            Partners::All => (0..self.balls.len()).for_each(&mut consider),
+            Partners::Lists(lists) => lists.partners(i).iter().for_each(|&j| consider(j as usize)),
+        }
+    }
+
+    /// When the centre of resting ball `i` leaves the face (axis `axis`) of box `k` it
+    /// rests on: the first time a tangential box-local coordinate crosses `±h`.
+    fn face_exit_time(&self, i: usize, k: usize, axis: usize) -> Option<T> {
+        let b = &self.boxes[k];
+        let obb = b.at(self.now);
+        let local = obb.to_local(&self.balls.position_at(i, self.now));
+        let rel_v = obb.vector_to_local(&(self.balls.velocity_at(i, self.now) - b.vel));
+        let rel_a = obb.vector_to_local(&self.balls.accel[i]);
+        let h = obb.half_extents();
+        let window = Window::unbounded(carom_toi::Direction::Forward);
+        let mut first: Option<T> = None;
+        for m in (0..D).filter(|&m| m != axis) {
+            for level in [-h[m], h[m]] {
+                let c = level_crossing(local[m], rel_v[m], rel_a[m], level, &window);
+                // Only a crossing from inside the face to outside ends the support.
+                let leaving = (level > T::zero()) == (c.to == carom_toi::Side::Upper);
+                if let Some(t) = c.time.finite().then_some(c.time)
+                    && leaving
+                    && first.is_none_or(|f| t < f)
+                {
+                    first = Some(t);
+                }
+            }
+        }
+        first
+    }
+}
+
+/// The earliest candidate event so far; later searches use its time as their horizon.
+struct Best<T: Real> {
+    time: T,
+    pending: Pending,
+}
+
+impl<T: Real> Best<T> {
+    /// Keeps `pending` at `time` if it is earlier (ties keep the first offered).
+    #[inline]
+    fn offer(&mut self, time: T, pending: Pending) {
+        if time < self.time {
+            self.time = time;
+            self.pending = pending;
+        }
+    }
+
+    /// A forward window from `now` to the best time so far.
+    #[inline]
+    fn window(&self, now: T) -> Window<T> {
+        Window::forward(self.time - now)
+            .unwrap_or_else(|_| Window::forward(T::zero()).expect("0 is a valid horizon"))
+    }
+}
+
+/// The time a point at `d` from its anchor, moving with velocity `v` and acceleration
+/// `a`, first reaches distance `radius` (it starts inside; 0 if it is not).
+///
+/// Without acceleration this is the exact root of `|d + v s|² = ρ²`, written without
+/// cancellation: with `b = d·v`, `c = |d|² − ρ² ≤ 0`, `Δ = b² − |v|² c`, the positive
+/// root is `(−b + √Δ)/|v|²`, equal to `−c / (b + √Δ)` when `b > 0`. With acceleration,
+/// the bound `|d| + |v| s + |a| s²/2 = ρ` gives a time at which the point is certainly
+/// still inside: `s = 2 (ρ − |d|) / (|v| + √(|v|² + 2 |a| (ρ − |d|)))`.
+pub(crate) fn exit_time<T: Real, const D: usize>(
+    d: &Vector<T, D>,
+    v: &Vector<T, D>,
+    a: &Vector<T, D>,
+    radius: T,
+) -> T {
+    let room = radius - d.norm();
+    if room <= T::zero() {
+        return T::zero();
+    }
+    if a.iter().all(|x| *x == T::zero()) {
+        let vv = v.norm_squared();
+        if vv == T::zero() {
+            return T::INFINITY;
+        }
+        let b = d.dot(v);
+        let c = (d.norm() - radius) * (d.norm() + radius);
+        let root = (b * b - vv * c).max(T::zero()).sqrt();
+        return if b > T::zero() {
+            -c / (b + root)
+        } else {
+            (root - b) / vv
+        };
+    }
+    let (speed, accel) = (v.norm(), a.norm());
+    let two = T::lit(2.0);
+    two * room / (speed + (speed * speed + two * accel * room).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::exit_time;
+    use nalgebra::Vector2;
+
+    #[test]
+    fn exit_time_is_exact_without_acceleration_and_conservative_with_it() {
+        let z = Vector2::<f64>::zeros();
+        assert_eq!(exit_time(&z, &Vector2::new(2.0, 0.0), &z, 1.0), 0.5);
+        // Starting at 0.6 moving away and towards: 0.4 and 1.6 to the circle.
+        assert!(
+            (exit_time(&Vector2::new(0.6, 0.0), &Vector2::new(1.0, 0.0), &z, 1.0) - 0.4).abs()
+                < 1e-15
+        );
+        assert!(
+            (exit_time(&Vector2::new(0.6, 0.0), &Vector2::new(-1.0, 0.0), &z, 1.0) - 1.6).abs()
+                < 1e-15
+        );
+        assert_eq!(exit_time(&z, &z, &z, 1.0), f64::INFINITY);
+        assert_eq!(exit_time(&Vector2::new(2.0, 0.0), &z, &z, 1.0), 0.0);
+        // Falling from rest under g = 2: |d| = s² reaches 1 at s = 1; the bound is exact here.
+        let s = exit_time(&z, &z, &Vector2::new(0.0, -2.0), 1.0);
+        assert!((s - 1.0).abs() < 1e-15);
+        // Thrown sideways under gravity: the bound is earlier than the true exit.
+        let (v, a) = (Vector2::new(1.0, 0.0), Vector2::new(0.0, -1.0));
+        let s = exit_time(&z, &v, &a, 1.0);
+        let p = v * s + a * (0.5 * s * s);
+        assert!(p.norm() <= 1.0 + 1e-15);
+    }
+}

@@ -1,0 +1,25 @@
+//! carom's engines and the scene model they run.
+//!
+//! * [`scene`]: the typed scene (balls, boxes, border, world settings), its validation,
+//!   and the TOML scene-file loader of the `carom run` contract (docs/scene-format.md).
+//! * [`scenes`]: scenes defined once for tests, benches, examples and the report.
+//! * [`plan`]: the planner — which engine, integrator and broad phase a scene needs.
+//! * [`event`]: the exact event-driven engine ([`EventEngine`]).
+//! * [`Simulation`]: what every engine offers; [`build`] constructs the planned one.
+//! * [`run`] and [`observe`]: driving a run (sample times, the summary) and measuring it
+//!   (energy, momentum, state hashes).
+
+mod build;
+mod engine;
+pub mod event;
+pub mod observe;
+pub mod plan;
+pub mod run;
+pub mod scene;
+pub mod scenes;
+
+pub use build::build;
+pub use engine::{
+    Angular, BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation,
+};
+pub use event::EventEngine;

@@ -1,0 +1,289 @@
+//! The planner: which engine and which components a scene needs.
+//!
+//! `carom run` lets the user force an engine, an integrator, a step or a broad phase;
+//! everything left on `auto` is decided here from the scene. The rule for the engine:
+//! the exact event-driven engine whenever the scene can be simulated exactly, the
+//! time-stepped engine otherwise (drag, or rigid clusters in 3D, whose torque-free
+//! tumbling has no closed form the event engine could use), or when the user asks for
+//! an integrator or a step. The engine then builds only the parts the scene uses and
+//! names them in [`Simulation::pipeline`](crate::Simulation::pipeline).
+
+use core::fmt;
+use core::str::FromStr;
+
+use carom_integrate::Integrator;
+use carom_math::Real;
+
+use crate::engine::EngineKind;
+use crate::scene::{Inelastic, Scene};
+
+/// The `--engine` choice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum EngineChoice {
+    /// Event-driven where the scene allows it exactly, stepped otherwise.
+    #[default]
+    Auto,
+    /// Force the event-driven engine.
+    Event,
+    /// Force the time-stepped engine.
+    Stepped,
+}
+
+/// The `--broad` choice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BroadChoice {
+    /// Chosen from the ball count and density.
+    #[default]
+    Auto,
+    /// Every pair (the best choice for a handful of balls).
+    Brute,
+    /// Sweep-and-prune (stepped engine).
+    Sap,
+    /// k-d tree (stepped engine).
+    Kd,
+    /// Uniform grid (the event engine's neighbour lists live on one).
+    Grid,
+}
+
+/// An unknown name for a `--engine` or `--broad` choice.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown {what} `{name}`, expected one of: {expected}")]
+pub struct UnknownChoice {
+    what: &'static str,
+    name: String,
+    expected: String,
+}
+
+macro_rules! named_choice {
+    ($ty:ty, $what:literal, $($variant:ident => $name:literal),+) => {
+        impl $ty {
+            /// The command-line name.
+            pub fn name(self) -> &'static str {
+                match self { $(Self::$variant => $name),+ }
+            }
+        }
+        impl fmt::Display for $ty {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+        impl FromStr for $ty {
+            type Err = UnknownChoice;
+            fn from_str(s: &str) -> Result<Self, Self::Err> {
+                match s {
+                    $($name => Ok(Self::$variant),)+
+                    _ => Err(UnknownChoice { what: $what, name: s.to_owned(), expected: [$($name),+].join(", ") }),
+                }
+            }
+        }
+    };
+}
+
+named_choice!(EngineChoice, "engine", Auto => "auto", Event => "event", Stepped => "stepped");
+named_choice!(BroadChoice, "broad phase", Auto => "auto", Brute => "brute", Sap => "sap", Kd => "kd", Grid => "grid");
+
+/// What the user asked for; `None` and `Auto` leave the choice to the planner.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct RunOptions {
+    /// The engine.
+    pub engine: EngineChoice,
+    /// The stepped engine's integrator.
+    pub integrator: Option<Integrator>,
+    /// The stepped engine's step (s).
+    pub dt: Option<f64>,
+    /// The broad phase.
+    pub broad: BroadChoice,
+}
+
+/// The stepped engine's default step: 1/600 s.
+pub const DEFAULT_DT: f64 = 1.0 / 600.0;
+
+/// The decisions for one run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plan {
+    /// The engine.
+    pub engine: EngineKind,
+    /// Why this engine (for messages and the report).
+    pub reason: &'static str,
+    /// The integrator (stepped engine only).
+    pub integrator: Option<Integrator>,
+    /// The step (stepped engine only).
+    pub dt: Option<f64>,
+    /// The broad-phase request, resolved further by the engine.
+    pub broad: BroadChoice,
+}
+
+/// Options that do not fit the scene or each other.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct PlanError(pub String);
+
+/// Why the event-driven engine cannot run a scene exactly, or `None` if it can.
+pub fn event_engine_limitation<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+) -> Option<&'static str> {
+    if scene.world.drag > T::zero() {
+        return Some("the scene has drag, which has no exact time of impact");
+    }
+    let stick = scene.world.inelastic == Inelastic::Stick
+        && (scene.world.restitution == T::zero()
+            || scene.balls.iter().any(|b| b.restitution == Some(T::zero())));
+    if stick {
+        if D == 3 {
+            return Some(
+                "stuck clusters tumble in 3D (torque-free precession), which has no closed form",
+            );
+        }
+        if scene.world.gravity.iter().any(|g| *g != T::zero()) {
+            return Some(
+                "stuck clusters under gravity would need resting rigid bodies, which the event engine does not model",
+            );
+        }
+        if !scene.boxes.is_empty() {
+            return Some("stuck clusters against boxes have no exact contact search in carom-toi");
+        }
+        if scene.world.border.is_some_and(|b| b.periodic) {
+            return Some("stuck clusters in a periodic box are not supported by the event engine");
+        }
+    }
+    None
+}
+
+/// Decides the engine and its options for `scene`.
+///
+/// # Errors
+/// A [`PlanError`] naming the flag when the options cannot work for this scene: the
+/// event engine forced on a scene it cannot simulate exactly, an integrator or a step
+/// with the event engine, a non-positive step, a broad phase the engine does not have.
+pub fn plan<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    options: &RunOptions,
+) -> Result<Plan, PlanError> {
+    let stepped_asked = options.integrator.is_some() || options.dt.is_some();
+    let limitation = event_engine_limitation(scene);
+    let (engine, reason) = match options.engine {
+        EngineChoice::Event => {
+            if let Some(why) = limitation {
+                return Err(PlanError(format!(
+                    "--engine event: {why}; use --engine stepped (or auto)"
+                )));
+            }
+            if stepped_asked {
+                return Err(PlanError(
+                    "--integrator and --dt apply to the stepped engine; the event engine is exact and has no step".into(),
+                ));
+            }
+            (EngineKind::Event, "requested with --engine event")
+        }
+        EngineChoice::Stepped => (EngineKind::Stepped, "requested with --engine stepped"),
+        EngineChoice::Auto => match (limitation, stepped_asked) {
+            (Some(why), _) => (EngineKind::Stepped, why),
+            (None, true) => (EngineKind::Stepped, "an integrator or a step was requested"),
+            (None, false) => (EngineKind::Event, "the scene can be simulated exactly"),
+        },
+    };
+    if let Some(dt) = options.dt
+        && !(dt.is_finite() && dt > 0.0)
+    {
+        return Err(PlanError(format!(
+            "--dt: must be a finite step > 0, got {dt}"
+        )));
+    }
+    if engine == EngineKind::Event && matches!(options.broad, BroadChoice::Sap | BroadChoice::Kd) {
+        return Err(PlanError(format!(
+            "--broad {}: the event engine finds partners with neighbour lists on a grid (--broad grid) or tests every pair (--broad brute)",
+            options.broad
+        )));
+    }
+    let (integrator, dt) = match engine {
+        EngineKind::Event => (None, None),
+        EngineKind::Stepped => (
+            Some(options.integrator.unwrap_or(Integrator::SemiImplicitEuler)),
+            Some(options.dt.unwrap_or(DEFAULT_DT)),
+        ),
+    };
+    Ok(Plan {
+        engine,
+        reason,
+        integrator,
+        dt,
+        broad: options.broad,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenes::classic;
+
+    #[test]
+    fn auto_picks_the_exact_engine_unless_the_scene_or_the_user_needs_steps() {
+        let mut s = classic::head_on(1.0, 1.0, 1.0, -1.0, 1.0);
+        assert_eq!(
+            plan(&s, &RunOptions::default()).unwrap().engine,
+            EngineKind::Event
+        );
+        let rk4 = RunOptions {
+            integrator: Some(Integrator::Rk4),
+            ..RunOptions::default()
+        };
+        let p = plan(&s, &rk4).unwrap();
+        assert_eq!(
+            (p.engine, p.integrator, p.dt),
+            (EngineKind::Stepped, Some(Integrator::Rk4), Some(DEFAULT_DT))
+        );
+        s.world.drag = 0.1;
+        let p = plan(&s, &RunOptions::default()).unwrap();
+        assert_eq!(p.engine, EngineKind::Stepped);
+        assert_eq!(p.integrator, Some(Integrator::SemiImplicitEuler));
+    }
+
+    #[test]
+    fn impossible_requests_name_the_flag() {
+        let mut s = classic::head_on(1.0, 1.0, 1.0, -1.0, 1.0);
+        let event = RunOptions {
+            engine: EngineChoice::Event,
+            ..RunOptions::default()
+        };
+        let e = plan(
+            &s,
+            &RunOptions {
+                dt: Some(0.01),
+                ..event
+            },
+        )
+        .unwrap_err();
+        assert!(e.0.starts_with("--integrator and --dt"), "{e}");
+        let e = plan(
+            &s,
+            &RunOptions {
+                broad: BroadChoice::Kd,
+                ..event
+            },
+        )
+        .unwrap_err();
+        assert!(e.0.starts_with("--broad kd"), "{e}");
+        let e = plan(
+            &s,
+            &RunOptions {
+                dt: Some(-1.0),
+                ..RunOptions::default()
+            },
+        )
+        .unwrap_err();
+        assert!(e.0.starts_with("--dt"), "{e}");
+        s.world.drag = 1.0;
+        assert!(plan(&s, &event).unwrap_err().0.contains("drag"));
+    }
+
+    #[test]
+    fn choices_parse_their_command_line_names() {
+        assert_eq!("stepped".parse::<EngineChoice>(), Ok(EngineChoice::Stepped));
+        assert_eq!("kd".parse::<BroadChoice>(), Ok(BroadChoice::Kd));
+        let e = "fast".parse::<EngineChoice>().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "unknown engine `fast`, expected one of: auto, event, stepped"
+        );
+    }
+}

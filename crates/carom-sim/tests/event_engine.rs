@@ -1,0 +1,642 @@
+//! The event-driven engine against closed forms, conservation laws and PhET's known gaps.
+
+use carom_geometry::{Border, Obb};
+use carom_math::Vector;
+use carom_sim::observe::{energy, momentum, state_hash};
+use carom_sim::plan::{BroadChoice, Plan};
+use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
+use carom_sim::scenes::classic;
+use carom_sim::scenes::gas::{GasParams, gas};
+use carom_sim::{BallStates, Collision, EngineKind, EventEngine, Observer, Simulation};
+use carom_toi::Direction;
+use nalgebra::{Const, Vector2, Vector3};
+
+fn plan(broad: BroadChoice) -> Plan {
+    Plan {
+        engine: EngineKind::Event,
+        reason: "test",
+        integrator: None,
+        dt: None,
+        broad,
+    }
+}
+
+#[derive(Default)]
+struct Log(Vec<Collision<f64>>);
+
+impl Observer<f64> for Log {
+    fn collision(&mut self, c: &Collision<f64>) {
+        self.0.push(*c);
+    }
+}
+
+/// Runs `scene` to `t` (negative: backwards) and returns the final states and the log.
+fn run<const D: usize>(
+    scene: &Scene<f64, D>,
+    t: f64,
+    broad: BroadChoice,
+) -> (BallStates<f64, D>, Vec<Collision<f64>>)
+where
+    Const<D>: carom_math::Space<f64, D>,
+{
+    let direction = if t < 0.0 {
+        Direction::Backward
+    } else {
+        Direction::Forward
+    };
+    let mut sim = EventEngine::new(scene, &plan(broad), direction).expect("a valid scene");
+    let mut log = Log::default();
+    sim.advance_to(t, &mut log).expect("the run completes");
+    let mut st = BallStates::default();
+    sim.states(&mut st);
+    (st, log.0)
+}
+
+/// The smallest surface gap between any two balls (minimum image in a periodic box).
+fn min_gap<const D: usize>(scene: &Scene<f64, D>, st: &BallStates<f64, D>) -> f64
+where
+    Const<D>: carom_math::Space<f64, D>,
+{
+    let periodic = scene.world.border.filter(|b| b.periodic).map(|b| b.border);
+    let mut gap = f64::INFINITY;
+    for i in 0..st.pos.len() {
+        for j in i + 1..st.pos.len() {
+            let d = st.pos[j] - st.pos[i];
+            let d = periodic.map_or(d, |b| b.minimum_image(&d));
+            gap = gap.min(d.norm() - scene.balls[i].radius - scene.balls[j].radius);
+        }
+    }
+    gap
+}
+
+#[test]
+fn head_on_collisions_match_the_textbook_for_every_restitution_and_mass_ratio() {
+    for (m0, m1) in [(1.0, 1.0), (0.5, 1.5), (1.0, 1e6), (1e6, 1.0)] {
+        for e in [0.0, 0.3, 1.0] {
+            let (u0, u1) = (1.0, -0.5);
+            let scene = classic::head_on(m0, m1, u0, u1, e);
+            let (st, log) = run(&scene, 3.0, BroadChoice::Auto);
+            // Gap 2 − 0.2 closes at 1.5 m/s.
+            assert_eq!(log.len(), 1, "{m0} {m1} {e}");
+            assert!((log[0].time() - 1.8 / 1.5).abs() < 1e-14);
+            let v0 = ((m0 - e * m1) * u0 + (1.0 + e) * m1 * u1) / (m0 + m1);
+            let v1 = ((m1 - e * m0) * u1 + (1.0 + e) * m0 * u0) / (m0 + m1);
+            let scale = u0.abs().max(u1.abs());
+            assert!(
+                (st.vel[0].x - v0).abs() < 1e-12 * scale,
+                "m {m0}/{m1} e {e}: {} vs {v0}",
+                st.vel[0].x
+            );
+            assert!(
+                (st.vel[1].x - v1).abs() < 1e-12 * scale,
+                "m {m0}/{m1} e {e}: {} vs {v1}",
+                st.vel[1].x
+            );
+            let p = momentum(&scene, &st).x;
+            assert!((p - (m0 * u0 + m1 * u1)).abs() <= 1e-12 * (m0 + m1) * scale);
+        }
+    }
+}
+
+#[test]
+fn an_oblique_elastic_collision_exchanges_only_the_normal_components() {
+    let b = 0.05; // impact parameter
+    let mut scene = classic::head_on(1.0, 1.0, 1.0, 0.0, 1.0);
+    scene.balls[0].pos = Vector2::new(-1.0, b);
+    scene.balls[1].pos = Vector2::new(0.0, 0.0);
+    let (st, log) = run(&scene, 2.0, BroadChoice::Auto);
+    assert_eq!(log.len(), 1);
+    // Contact when (x² + b²) = 0.2²: x = −√(0.04 − b²).
+    let x = -(0.04_f64 - b * b).sqrt();
+    assert!((log[0].time() - (x + 1.0)).abs() < 1e-14);
+    let n = Vector2::new(-x, -b) / 0.2;
+    let v0 = Vector2::new(1.0, 0.0);
+    let (e0, e1) = (v0 - n * v0.dot(&n), n * v0.dot(&n));
+    assert!((st.vel[0] - e0).norm() < 1e-14 && (st.vel[1] - e1).norm() < 1e-14);
+}
+
+#[test]
+fn newtons_cradle_passes_the_momentum_to_the_last_ball() {
+    for n in [1, 2, 5, 20] {
+        let scene = classic::newtons_cradle(n, 1.0);
+        let (st, log) = run(&scene, 2.0, BroadChoice::Auto);
+        assert_eq!(log.len(), n, "one collision per touching pair");
+        for (k, v) in st.vel.iter().enumerate().take(n) {
+            assert!(v.norm() < 1e-12, "ball {k} of {n} should rest, has {v:?}");
+        }
+        assert!((st.vel[n] - Vector2::new(1.0, 0.0)).norm() < 1e-12);
+        assert!(min_gap(&scene, &st) >= -1e-12);
+    }
+}
+
+#[test]
+fn grazing_by_a_nanometre_is_decided_right() {
+    for (offset, hit) in [(0.2 + 1e-9, false), (0.2 - 1e-9, true)] {
+        let mut scene = classic::head_on(1.0, 1.0, 1.0, 0.0, 1.0);
+        scene.balls[0].pos = Vector2::new(-1.0, offset);
+        let (_, log) = run(&scene, 3.0, BroadChoice::Auto);
+        assert_eq!(!log.is_empty(), hit, "offset {offset}");
+    }
+}
+
+#[test]
+fn a_slow_closing_across_a_tiny_gap_is_one_exact_collision_not_a_false_one() {
+    // PhET's linear fallback fires false collisions for slow closings; here the exact
+    // root gives the time of a 1e-12 gap closed at 1e-6 m/s.
+    let mut scene = classic::head_on(1.0, 1.0, 1e-6, 0.0, 1.0);
+    scene.balls[0].pos = Vector2::new(-0.2 - 1e-12, 0.0);
+    scene.balls[1].pos = Vector2::new(0.0, 0.0);
+    let (_, log) = run(&scene, 1.0, BroadChoice::Auto);
+    assert_eq!(log.len(), 1);
+    // The gap the scene really holds: |x₀| − 0.2, exact by Sterbenz (0.2 = 0.1 + 0.1 exactly).
+    let gap = -scene.balls[0].pos.x - 0.2;
+    assert!((gap - 1e-12).abs() < 1e-16);
+    let expected = gap / 1e-6;
+    assert!(
+        (log[0].time() - expected).abs() < 8.0 * f64::EPSILON * expected,
+        "{} vs {expected}",
+        log[0].time()
+    );
+    // Receding at 1e-6 m/s from touching: no collision at all.
+    let mut away = scene.clone();
+    away.balls[0].pos = Vector2::new(-0.2, 0.0);
+    away.balls[0].vel = Vector2::new(-1e-6, 0.0);
+    assert!(run(&away, 1.0, BroadChoice::Auto).1.is_empty());
+}
+
+#[test]
+fn balls_at_a_million_metres_per_second_never_leave_the_box_or_pass_each_other() {
+    let border = Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0)).unwrap();
+    let scene = Scene {
+        name: None,
+        world: World {
+            border: Some(BorderSpec {
+                border,
+                restitution: 1.0,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls: vec![
+            BallSpec::new(Vector2::new(-0.5, 0.0), Vector2::new(1e6, 3.7e5), 0.05, 1.0),
+            BallSpec::new(Vector2::new(0.5, 0.0), Vector2::new(-1e6, 1.3e5), 0.05, 1.0),
+        ],
+        boxes: Vec::new(),
+    };
+    let mut sim = EventEngine::new(&scene, &plan(BroadChoice::Auto), Direction::Forward).unwrap();
+    let mut st = BallStates::default();
+    for k in 1..=100 {
+        sim.advance_to(f64::from(k) * 1e-5, &mut ()).unwrap();
+        sim.states(&mut st);
+        for p in &st.pos {
+            assert!(
+                p.x.abs() <= 0.95 + 1e-9 && p.y.abs() <= 0.95 + 1e-9,
+                "{p:?}"
+            );
+        }
+        assert!(min_gap(&scene, &st) >= -1e-9);
+    }
+    assert!(sim.counters().ball_ball > 0 && sim.counters().ball_border > 100);
+    let e = energy(&scene, &st);
+    assert!((e - 0.5 * (1e12 + 3.7e5f64.powi(2) + 1e12 + 1.3e5f64.powi(2))).abs() < 1e-10 * e);
+}
+
+#[test]
+fn a_ball_starting_partly_outside_the_border_is_brought_back_not_lost() {
+    // PhET lets such a ball escape for good. Overlap allowed by the contract: 1e-9 m.
+    let border = Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0)).unwrap();
+    let scene = Scene {
+        name: None,
+        world: World {
+            border: Some(BorderSpec {
+                border,
+                restitution: 1.0,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls: vec![BallSpec::new(
+            Vector2::new(0.9 + 5e-10, 0.0),
+            Vector2::new(2.0, 0.0),
+            0.1,
+            1.0,
+        )],
+        boxes: Vec::new(),
+    };
+    let (st, log) = run(&scene, 0.5, BroadChoice::Auto);
+    assert!(matches!(log[0], Collision::BallBorder { time, .. } if time == 0.0));
+    assert!((st.vel[0].x + 2.0).abs() < 1e-15);
+    assert!((st.pos[0].x - (0.9 + 5e-10 - 1.0)).abs() < 1e-12);
+}
+
+#[test]
+fn a_dropped_ball_bounces_to_e_squared_heights_and_comes_to_rest() {
+    let (h, e) = (1.0, 0.5);
+    for dim3 in [false, true] {
+        let (log, rest_height, rest_speed) = if dim3 {
+            let scene = classic::ball_drop::<3>(h, e);
+            let (st, log) = run(&scene, 10.0, BroadChoice::Auto);
+            (log, st.pos[0].z, st.vel[0].norm())
+        } else {
+            let scene = classic::ball_drop::<2>(h, e);
+            let (st, log) = run(&scene, 10.0, BroadChoice::Auto);
+            (log, st.pos[0].y, st.vel[0].norm())
+        };
+        let g = 9.81;
+        // The first impact after √(2h/g); flight k lasts 2 e^k √(2gh)/g.
+        let v0 = (2.0 * g * h).sqrt();
+        let mut expected = (2.0 * h / g).sqrt();
+        for (k, c) in log.iter().take(8).enumerate() {
+            assert!(
+                (c.time() - expected).abs() < 1e-12,
+                "bounce {k}: {} vs {expected}",
+                c.time()
+            );
+            expected += 2.0 * e.powi(k as i32 + 1) * v0 / g;
+        }
+        assert!(
+            log.len() < 100,
+            "Zeno bouncing must end: {} bounces",
+            log.len()
+        );
+        assert!(
+            (rest_height - 0.1).abs() < 1e-12,
+            "rests on the floor at its radius: {rest_height}"
+        );
+        assert!(rest_speed < 1e-12);
+    }
+}
+
+#[test]
+fn an_elastic_gas_conserves_energy_to_1e_10_and_never_overlaps() {
+    for (periodic, broad) in [
+        (false, BroadChoice::Auto),
+        (true, BroadChoice::Auto),
+        (false, BroadChoice::Brute),
+    ] {
+        let p = GasParams {
+            n: 300,
+            fraction: 0.3,
+            periodic,
+            seed: 11,
+            ..GasParams::default()
+        };
+        let scene = gas::<2>(&p).unwrap();
+        let mut sim = EventEngine::new(&scene, &plan(broad), Direction::Forward).unwrap();
+        let mut st = BallStates::default();
+        sim.states(&mut st);
+        let (e0, p0) = (energy(&scene, &st), momentum(&scene, &st));
+        for k in 1..=5 {
+            sim.advance_to(f64::from(k) * 4.0, &mut ()).unwrap();
+            sim.states(&mut st);
+            assert!(
+                min_gap(&scene, &st) >= -1e-12 * 20.0,
+                "overlap at sample {k}"
+            );
+        }
+        assert!(sim.counters().ball_ball > 3000, "{:?}", sim.counters());
+        let e1 = energy(&scene, &st);
+        assert!(
+            ((e1 - e0) / e0).abs() < 1e-10,
+            "energy drift {}",
+            (e1 - e0) / e0
+        );
+        if periodic {
+            assert!(
+                (momentum(&scene, &st) - p0).norm() < 1e-10 * e0.sqrt(),
+                "momentum in a periodic box"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_3d_periodic_hard_sphere_gas_conserves_energy_and_momentum() {
+    let p = GasParams {
+        n: 500,
+        fraction: 0.45,
+        periodic: true,
+        seed: 3,
+        ..GasParams::default()
+    };
+    let scene = gas::<3>(&p).unwrap();
+    let (st, log) = run(&scene, 2.0, BroadChoice::Auto);
+    assert!(log.len() > 10_000);
+    let mut st0 = BallStates::default();
+    EventEngine::new(&scene, &plan(BroadChoice::Auto), Direction::Forward)
+        .unwrap()
+        .states(&mut st0);
+    let (e0, e1) = (energy(&scene, &st0), energy(&scene, &st));
+    assert!(((e1 - e0) / e0).abs() < 1e-10);
+    assert!(momentum(&scene, &st).norm() < 1e-10);
+    assert!(min_gap(&scene, &st) >= -1e-12 * 10.0);
+}
+
+#[test]
+fn running_back_from_the_end_returns_to_the_start() {
+    let p = GasParams {
+        n: 40,
+        fraction: 0.2,
+        seed: 5,
+        ..GasParams::default()
+    };
+    let scene = gas::<2>(&p).unwrap();
+    let (end, forward) = run(&scene, 3.0, BroadChoice::Auto);
+    assert!(forward.len() > 20);
+    let mut back = scene.clone();
+    for (k, b) in back.balls.iter_mut().enumerate() {
+        b.pos = end.pos[k];
+        b.vel = end.vel[k];
+    }
+    let (start, backward) = run(&back, -3.0, BroadChoice::Auto);
+    assert_eq!(backward.len(), forward.len());
+    for (k, b) in scene.balls.iter().enumerate() {
+        assert!(
+            (start.pos[k] - b.pos).norm() < 1e-9,
+            "ball {k}: {:?} vs {:?}",
+            start.pos[k],
+            b.pos
+        );
+        assert!((start.vel[k] - b.vel).norm() < 1e-9);
+    }
+}
+
+#[test]
+fn the_same_scene_gives_the_same_bits_every_run() {
+    let scene = gas::<3>(&GasParams {
+        n: 300,
+        fraction: 0.3,
+        periodic: true,
+        ..GasParams::default()
+    })
+    .unwrap();
+    let (a, _) = run(&scene, 1.0, BroadChoice::Auto);
+    let (b, _) = run(&scene, 1.0, BroadChoice::Auto);
+    assert_eq!(state_hash(&a), state_hash(&b));
+}
+
+#[test]
+fn cutting_a_run_into_pieces_does_not_change_it() {
+    let scene = gas::<2>(&GasParams {
+        n: 200,
+        fraction: 0.3,
+        ..GasParams::default()
+    })
+    .unwrap();
+    let (whole, _) = run(&scene, 2.0, BroadChoice::Auto);
+    let mut sim = EventEngine::new(&scene, &plan(BroadChoice::Auto), Direction::Forward).unwrap();
+    for k in 1..=37 {
+        sim.advance_to(2.0 * f64::from(k) / 37.0, &mut ()).unwrap();
+    }
+    let mut pieces = BallStates::default();
+    sim.states(&mut pieces);
+    assert_eq!(state_hash(&whole), state_hash(&pieces));
+}
+
+#[test]
+fn a_ball_bounces_off_a_rotated_box_like_off_a_tilted_mirror() {
+    // A 45° box under a ball falling straight down: it leaves horizontally.
+    let wall = Obb::from_angle(
+        Vector2::new(0.0, 0.0),
+        Vector2::new(1.0, 0.1),
+        std::f64::consts::FRAC_PI_4,
+    )
+    .unwrap();
+    let scene = Scene {
+        name: None,
+        world: World::default(),
+        balls: vec![BallSpec::new(
+            Vector2::new(0.0, 2.0),
+            Vector2::new(0.0, -1.0),
+            0.1,
+            1.0,
+        )],
+        boxes: vec![BoxSpec {
+            shape: wall,
+            vel: Vector2::zeros(),
+            restitution: 1.0,
+        }],
+    };
+    let (st, log) = run(&scene, 3.0, BroadChoice::Auto);
+    assert_eq!(log.len(), 1);
+    assert!(matches!(log[0], Collision::BallBox { k: 0, .. }));
+    // The face normal is (−sin 45°, cos 45°); the reflected velocity is (−1, 0).
+    assert!(
+        (st.vel[0] - Vector2::new(-1.0, 0.0)).norm() < 1e-12,
+        "{:?}",
+        st.vel[0]
+    );
+}
+
+#[test]
+fn a_moving_paddle_sends_a_resting_ball_off_at_one_plus_e_times_its_speed() {
+    for e in [1.0, 0.5] {
+        let paddle =
+            Obb::from_angle(Vector2::new(-1.0, 0.0), Vector2::new(0.05, 0.5), 0.0).unwrap();
+        let scene = Scene {
+            name: None,
+            world: World::default(),
+            balls: vec![BallSpec::new(
+                Vector2::new(0.0, 0.0),
+                Vector2::zeros(),
+                0.1,
+                1.0,
+            )],
+            boxes: vec![BoxSpec {
+                shape: paddle,
+                vel: Vector2::new(2.0, 0.0),
+                restitution: e,
+            }],
+        };
+        let (st, log) = run(&scene, 1.0, BroadChoice::Auto);
+        assert_eq!(log.len(), 1);
+        assert!((st.vel[0].x - (1.0 + e) * 2.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn an_inelastic_column_does_not_collapse_under_the_tc_model() {
+    // McNamara–Young: balls on a line between two walls with e = 0.5 collapse without a
+    // guard. The run must reach its end with finite work.
+    let border = Border::new(Vector2::new(-1.0, -0.2), Vector2::new(5.0, 0.2)).unwrap();
+    let balls = (0..20)
+        .map(|k| {
+            BallSpec::new(
+                Vector2::new(0.25 * f64::from(k), 0.0),
+                Vector2::new(if k % 2 == 0 { 1.0 } else { -1.0 }, 0.0),
+                0.1,
+                1.0,
+            )
+        })
+        .collect();
+    let scene = Scene {
+        name: None,
+        world: World {
+            restitution: 0.5,
+            border: Some(BorderSpec {
+                border,
+                restitution: 1.0,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls,
+        boxes: Vec::new(),
+    };
+    let (st, log) = run(&scene, 50.0, BroadChoice::Auto);
+    assert!(log.len() < 2_000_000, "{} events", log.len());
+    assert!(min_gap(&scene, &st) >= -1e-9);
+}
+
+#[test]
+fn f32_runs_keep_balls_apart_and_conserve_energy_to_single_precision() {
+    let scene = gas::<2>(&GasParams {
+        n: 200,
+        fraction: 0.3,
+        ..GasParams::default()
+    })
+    .unwrap()
+    .cast::<f32>()
+    .unwrap();
+    let mut sim = EventEngine::new(
+        &scene,
+        &Plan {
+            broad: BroadChoice::Auto,
+            ..plan(BroadChoice::Auto)
+        },
+        Direction::Forward,
+    )
+    .unwrap();
+    let mut st = BallStates::<f32, 2>::default();
+    sim.states(&mut st);
+    let e0 = energy(&scene, &st);
+    sim.advance_to(5.0, &mut ()).unwrap();
+    sim.states(&mut st);
+    let e1 = energy(&scene, &st);
+    assert!(sim.counters().ball_ball > 1000);
+    assert!(((e1 - e0) / e0).abs() < 1e-4, "{}", (e1 - e0) / e0);
+    let mut worst = f32::INFINITY;
+    for i in 0..st.pos.len() {
+        for j in i + 1..st.pos.len() {
+            worst = worst.min((st.pos[j] - st.pos[i]).norm() - 1.0);
+        }
+    }
+    assert!(worst > -1e-4, "f32 overlap {worst}");
+}
+
+#[test]
+fn three_dimensional_scenes_with_walls_and_boxes_run() {
+    let border = Border::new(Vector3::repeat(-2.0), Vector3::repeat(2.0)).unwrap();
+    let table = Obb::from_axis_angle(
+        Vector3::new(0.0, 0.0, -1.0),
+        Vector3::new(1.5, 1.0, 0.05),
+        Vector3::new(0.1, 0.2, 0.0),
+    )
+    .unwrap();
+    let scene = Scene {
+        name: None,
+        world: World {
+            gravity: Vector3::new(0.0, 0.0, -9.81),
+            restitution: 0.9,
+            border: Some(BorderSpec {
+                border,
+                restitution: 0.8,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls: (0..12)
+            .map(|k| {
+                let k = f64::from(k);
+                BallSpec::new(
+                    Vector3::new(-1.0 + 0.18 * k, 0.1 * (k % 3.0), 0.5 + 0.1 * (k % 2.0)),
+                    Vector3::new((k * 0.7).sin(), (k * 1.3).cos(), 0.0),
+                    0.05,
+                    0.1,
+                )
+            })
+            .collect(),
+        boxes: vec![BoxSpec {
+            shape: table,
+            vel: Vector::<f64, 3>::zeros(),
+            restitution: 0.7,
+        }],
+    };
+    let (st, log) = run(&scene, 5.0, BroadChoice::Auto);
+    assert!(log.iter().any(|c| matches!(c, Collision::BallBox { .. })));
+    assert!(min_gap(&scene, &st) >= -1e-9);
+    for p in &st.pos {
+        assert!(
+            p.iter().all(|x| x.abs() <= 2.0 - 0.05 + 1e-9),
+            "inside the border: {p:?}"
+        );
+    }
+}
+
+#[test]
+fn every_collision_lab_screen_runs_and_keeps_what_the_sim_teaches() {
+    use carom_sim::scene::Inelastic;
+    use carom_sim::scenes::collision_lab::{InelasticPreset, Options, Screen, scene};
+    let screens = [
+        Screen::Intro,
+        Screen::Explore1d,
+        Screen::Explore2d,
+        Screen::Inelastic(InelasticPreset::HeadOn),
+        Screen::Inelastic(InelasticPreset::CrissCross),
+        Screen::Inelastic(InelasticPreset::Glancing),
+    ];
+    for screen in screens {
+        for elasticity in [None, Some(100.0), Some(50.0), Some(0.0)] {
+            for inelastic in [Inelastic::Slide, Inelastic::Stick] {
+                for reflecting_border in [true, false] {
+                    let opts = Options {
+                        elasticity_percent: elasticity,
+                        reflecting_border,
+                        inelastic,
+                        ..Options::default()
+                    };
+                    let s = scene(screen, &opts);
+                    let mut sim =
+                        EventEngine::new(&s, &plan(BroadChoice::Auto), Direction::Forward).unwrap();
+                    let mut st = BallStates::default();
+                    sim.states(&mut st);
+                    let (e0, p0) = (energy(&s, &st), momentum(&s, &st));
+                    let mut log = Log::default();
+                    sim.advance_to(10.0, &mut log).unwrap();
+                    sim.states(&mut st);
+                    let (e1, p1) = (energy(&s, &st), momentum(&s, &st));
+                    let what = format!("{screen:?} {opts:?}");
+                    assert!(e1 <= e0 * (1.0 + 1e-12), "{what}: energy grew {e0} → {e1}");
+                    if s.world.restitution == 1.0 {
+                        assert!(
+                            (e1 - e0).abs() <= 1e-12 * e0,
+                            "{what}: elastic energy {e0} → {e1}"
+                        );
+                    }
+                    let walls = log
+                        .0
+                        .iter()
+                        .any(|c| matches!(c, Collision::BallBorder { .. }));
+                    if !walls {
+                        assert!(
+                            (p1 - p0).norm() <= 1e-12 * (1.0 + p0.norm()),
+                            "{what}: momentum {p0:?} → {p1:?}"
+                        );
+                    }
+                    if reflecting_border {
+                        let b = s.world.border.unwrap().border;
+                        for (k, p) in st.pos.iter().enumerate() {
+                            let r = s.balls[k].radius;
+                            assert!(
+                                (0..2).all(|a| p[a] - r >= b.min()[a] - 1e-9
+                                    && p[a] + r <= b.max()[a] + 1e-9),
+                                "{what}: ball {k} outside"
+                            );
+                        }
+                    }
+                    assert!(min_gap(&s, &st) >= -1e-9, "{what}: overlap");
+                }
+            }
+        }
+    }
+}
