@@ -133,10 +133,6 @@ fn unit<T: Real>() -> T {
     T::EPSILON * T::lit(0.5)
 }
 
-/// Relative error, in `u`, up to which [`LinearSphere::quadratic`] keeps a coefficient
-/// without sharpening it.
-const COEFFICIENT_BUDGET: f64 = 8.0;
-
 /// A computed value and a bound on its error.
 #[derive(Clone, Copy, Debug)]
 struct Bounded<T> {
@@ -352,14 +348,14 @@ impl<T: Real, const D: usize> LinearSphere<T, D> {
         h.square_minus_product(a.finish(), c)
     }
 
-    /// `a t² + 2 h t + c` with every coefficient within `8 u` of exact (plain where the
-    /// bounds prove it, sharpened otherwise); `None` on overflow.
-    pub(crate) fn quadratic(&self) -> Option<Quadratic<T>> {
+    /// `a t² + 2 h t + c` with every coefficient within `budget` (relative) of exact:
+    /// plain where the bounds prove it, sharpened otherwise (the double-double `Δ` is
+    /// within about `u`); `None` on overflow.
+    pub(crate) fn quadratic(&self, budget: T) -> Option<Quadratic<T>> {
         let p = self.plain();
         if !p.disc.err.finite() {
             return None;
         }
-        let budget = T::lit(COEFFICIENT_BUDGET) * unit::<T>();
         if p.h.within(budget) && p.c.within(budget) && p.disc.within(budget) {
             return Some(Quadratic::with_discriminant(
                 p.a,
@@ -429,5 +425,260 @@ fn contact_before<T: Real>(t: T, hi: T) -> LinearContact<T> {
         LinearContact::At(t)
     } else {
         LinearContact::Clear
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The bounds and decisions against exact integer arithmetic: integer-valued inputs
+    //! (below `2^30`) make every coefficient an exact `i128` (`Δ` below `2^124`), while
+    //! their products exceed 53 bits, so the plain evaluation does round.
+
+    use super::*;
+    use nalgebra::Vector3;
+    use proptest::prelude::*;
+
+    const U: f64 = f64::EPSILON / 2.0;
+
+    /// The exact coefficients of `|u + w t|² − r²` for integer inputs.
+    #[derive(Debug)]
+    struct Exact {
+        h: i128,
+        a: i128,
+        c: i128,
+        disc: i128,
+    }
+
+    fn exact(u: [i64; 3], w: [i64; 3], r: i64) -> Exact {
+        let dot = |x: [i64; 3], y: [i64; 3]| -> i128 {
+            x.iter()
+                .zip(y)
+                .map(|(&a, b)| i128::from(a) * i128::from(b))
+                .sum()
+        };
+        let (h, a) = (dot(u, w), dot(w, w));
+        let c = dot(u, u) - i128::from(r) * i128::from(r);
+        Exact {
+            h,
+            a,
+            c,
+            disc: h * h - a * c,
+        }
+    }
+
+    fn sphere(u: [i64; 3], w: [i64; 3], r: i64) -> LinearSphere<f64, 3> {
+        let f = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
+        LinearSphere::new(f(u), f(w), r as f64)
+    }
+
+    /// `|computed − exact| <= bound`; every computed value is an integer here (sums and
+    /// products of integers round to integers).
+    fn within(computed: f64, exact: i128, bound: f64) -> bool {
+        assert_eq!(computed.fract(), 0.0);
+        ((computed as i128) - exact).unsigned_abs() as f64 <= bound
+    }
+
+    /// The reference answer: status from the exact signs, root in f64 from the exact
+    /// integers (within about `4u`).
+    fn reference(e: &Exact, r: i64) -> LinearContact<f64> {
+        let touch = (r as f64 * r as f64) * (2.0 * U);
+        if e.h >= 0 {
+            LinearContact::Clear
+        } else if (e.c as f64) <= touch {
+            LinearContact::Immediate
+        } else if e.disc <= 0 {
+            LinearContact::Clear
+        } else {
+            LinearContact::At(e.c as f64 / ((e.disc as f64).sqrt() - e.h as f64))
+        }
+    }
+
+    /// `first_contact` agrees with the reference, the root within `16u` (the guarantee)
+    /// plus the reference's own `4u`.
+    fn agrees(u: [i64; 3], w: [i64; 3], r: i64, budget: f64) -> Result<(), TestCaseError> {
+        let e = exact(u, w, r);
+        let got = sphere(u, w, r).first_contact(f64::INFINITY, budget);
+        match (got, reference(&e, r)) {
+            (LinearContact::At(t), LinearContact::At(t_ref)) => {
+                prop_assert!(
+                    (t - t_ref).abs() <= 20.0 * U * t_ref,
+                    "{t} vs {t_ref} {e:?}"
+                );
+            }
+            (got, want) => prop_assert_eq!(got, want, "{:?}", e),
+        }
+        Ok(())
+    }
+
+    fn int3() -> impl Strategy<Value = [i64; 3]> {
+        prop::array::uniform3(-(1i64 << 29)..(1i64 << 29))
+    }
+
+    /// `u` and `w` with `u·w < 0` (closing), from any pair.
+    fn closing(u: [i64; 3], w: [i64; 3]) -> ([i64; 3], [i64; 3]) {
+        if exact(u, w, 0).h > 0 {
+            (u, w.map(|x| -x))
+        } else {
+            (u, w)
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// The plain and sharpened bounds of the module docs hold.
+        #[test]
+        fn bounds_hold(u in int3(), w in int3(), r in 1i64..(1 << 29)) {
+            let e = exact(u, w, r);
+            let s = sphere(u, w, r);
+            let p = s.plain();
+            prop_assert!(within(p.h.value, e.h, p.h.err), "h {p:?} {e:?}");
+            prop_assert!(within(p.c.value, e.c, p.c.err), "c {p:?} {e:?}");
+            prop_assert!(within(p.disc.value, e.disc, p.disc.err), "disc {p:?} {e:?}");
+            let (dd_h, dd_c, sharp) = s.sharpen(&p);
+            prop_assert!(within(sharp.h.value, e.h, sharp.h.err));
+            prop_assert!(within(sharp.c.value, e.c, sharp.c.err));
+            prop_assert!(within(sharp.disc.value, e.disc, sharp.disc.err));
+            // The double-double discriminant: one rounding plus u² of the terms.
+            let disc = s.exact_discriminant(dd_h, dd_c);
+            let terms = (e.h * e.h) as f64 + (e.a as f64) * (e.c.abs() as f64);
+            prop_assert!(within(disc, e.disc, U * (e.disc.abs() as f64) * 1.01 + 64.0 * U * U * terms));
+        }
+
+        /// The quick test only ever claims a certain recession or miss, also in f32 where
+        /// the differences of the inputs round.
+        #[test]
+        fn quick_test_is_never_wrong(
+            c1 in int3(), c2 in int3(), v1 in int3(), v2 in int3(),
+            r1 in 1i64..(1 << 28), r2 in 1i64..(1 << 28), backward in any::<bool>(),
+        ) {
+            let sign = if backward { -1 } else { 1 };
+            let d = |x: [i64; 3], y: [i64; 3]| [0, 1, 2].map(|i| y[i] - x[i]);
+            // f32 inputs: round each to f32 and take the exact integer it became.
+            let f = |x: [i64; 3]| x.map(|v| v as f32 as i64);
+            let (c1f, c2f, v1f, v2f) = (f(c1), f(c2), f(v1), f(v2));
+            let (r1f, r2f) = (r1 as f32 as i64, r2 as f32 as i64);
+            let e = exact(d(c1f, c2f), d(v1f, v2f).map(|x| x * sign), r1f + r2f);
+            let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
+            if recedes_or_misses(
+                (&v3(c1f), &v3(c2f)),
+                (&v3(v1f), &v3(v2f)),
+                (r1f as f32, r2f as f32),
+                sign as f32,
+            ) {
+                prop_assert!(e.h > 0 || e.disc < 0, "{e:?}");
+            }
+            let e = exact(d(c1, c2), d(v1, v2).map(|x| x * sign), r1 + r2);
+            let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
+            if recedes_or_misses((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1 as f64, r2 as f64), sign as f64) {
+                prop_assert!(e.h > 0 || e.disc < 0, "{e:?}");
+            }
+        }
+
+        /// The quick test near its boundaries: grazes far away and tangential motions
+        /// (as below), placed at random offsets so that the differences of the inputs
+        /// round, in f32 and f64.
+        #[test]
+        fn quick_test_is_never_wrong_near_its_boundaries(
+            w in prop::array::uniform3(-(1i64 << 20)..(1 << 20)), s in -(1i64 << 8)..0,
+            p in prop::array::uniform3(-(1i64 << 12)..(1 << 12)), delta in -8i64..=8,
+            k in 1i64..16, z in -8i64..=8, tangential in any::<bool>(),
+            offset in int3(), drift in int3(),
+        ) {
+            let (u, w, r) = if tangential {
+                let (a, b) = (w[0] << 8, w[1] << 8);
+                let r = ((a * a + b * b + 1) as f64).sqrt() as i64 + delta.signum();
+                ([a, b, 1], [-k * b, k * a, z], r.max(2))
+            } else {
+                let u = [0, 1, 2].map(|i| s * w[i] + p[i]);
+                let e = exact(u, w, 0);
+                prop_assume!(e.a > 0);
+                let miss = ((-e.disc) as f64 / e.a as f64).sqrt();
+                (u, w, (miss.round() as i64 + delta).max(2))
+            };
+            let add = |x: [i64; 3], y: [i64; 3]| [0, 1, 2].map(|i| x[i] + y[i]);
+            let (c1, c2, v1, v2) = (offset, add(offset, u), drift, add(drift, w));
+            for sign in [1, -1] {
+                // f32: every input rounds to f32; the reference takes the rounded values.
+                let f = |x: [i64; 3]| x.map(|v| v as f32 as i64);
+                let d = |x: [i64; 3], y: [i64; 3]| [0, 1, 2].map(|i| y[i] - x[i]);
+                let (r1, r2) = ((r / 2) as f32 as i64, (r - r / 2) as f32 as i64);
+                let e = exact(d(f(c1), f(c2)), d(f(v1), f(v2)).map(|x| x * sign), r1 + r2);
+                let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
+                if recedes_or_misses(
+                    (&v3(c1), &v3(c2)),
+                    (&v3(v1), &v3(v2)),
+                    (r1 as f32, r2 as f32),
+                    sign as f32,
+                ) {
+                    prop_assert!(e.h > 0 || e.disc < 0, "f32 {e:?}");
+                }
+                let e = exact(u, w.map(|x| x * sign), r);
+                let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
+                let (r1, r2) = ((r / 2) as f64, (r - r / 2) as f64);
+                if recedes_or_misses((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1, r2), sign as f64) {
+                    prop_assert!(e.h > 0 || e.disc < 0, "f64 {e:?}");
+                }
+            }
+        }
+
+        /// Random pairs: mostly decided and solved by the plain values.
+        #[test]
+        fn random_pairs_match_exact_arithmetic(u in int3(), w in int3(), r in 1i64..(1 << 29)) {
+            agrees(u, w, r, 12.0 * U)?;
+        }
+
+        /// A graze far away: `u = s w + p` (`s` up to `−2⁸`, `p` small), so the miss
+        /// distance is about `|p|` while `|u| ≈ |s| |w|` is up to `2²⁴` times larger; the
+        /// radius is the miss distance rounded, moved by `δ`. `Δ = |w|² r² − |u ∧ w|²`
+        /// is then within a few `|w|² r` of zero while `h² ≈ a c ≈ |u|² |w|²`: inside the
+        /// plain bound for small `δ` (decided in double-double), outside for large ones.
+        #[test]
+        fn grazes_far_away_match_exact_arithmetic(
+            w in prop::array::uniform3(-(1i64 << 20)..(1 << 20)), s in -(1i64 << 8)..0,
+            p in prop::array::uniform3(-(1i64 << 12)..(1 << 12)), delta in -8i64..=8,
+        ) {
+            let u = [0, 1, 2].map(|i| s * w[i] + p[i]);
+            let e = exact(u, w, 0);
+            prop_assume!(e.h < 0 && e.a > 0);
+            // With r = 0, Δ = h² − a |u|² = −|u ∧ w|²: the miss distance is √(−Δ/a).
+            let miss = ((-e.disc) as f64 / e.a as f64).sqrt();
+            let r = (miss.round() as i64 + delta).max(1);
+            agrees(u, w, r, 12.0 * U)?;
+            // Forcing the double-double root changes nothing but accuracy.
+            agrees(u, w, r, 0.0)?;
+        }
+
+        /// Nearly touching: `u = (r, x, y)` (permuted, signs flipped) with `x² + y²` up to
+        /// 1024, so `c` is between 0 and 1024 against `r² ≈ 2⁵⁸`: touching (`c <= 2u r²`,
+        /// about 64), or apart by less than the plain bound.
+        #[test]
+        fn near_touching_matches_exact_arithmetic(
+            r in (1i64 << 28)..(1 << 29), x in 0i64..32, y in 0i64..32, w in int3(),
+            perm in 0usize..3, signs in prop::array::uniform3(any::<bool>()), inside in any::<bool>(),
+        ) {
+            let mut u = [r, x, y];
+            u.rotate_left(perm);
+            for (v, s) in u.iter_mut().zip(signs) {
+                if s { *v = -*v; }
+            }
+            let (u, w) = closing(u, w);
+            let r = if inside { r + 1 } else { r };
+            agrees(u, w, r, 12.0 * U)?;
+        }
+
+        /// Tangential motion: `u = (a, b, 1)`, `w = (−k b, k a, z)`, so `u·w = z`, a few
+        /// units against `Σ|uᵢwᵢ| ≈ 2⁵⁹`: the sign of the rate is beyond the plain bound
+        /// and decides touching pairs (closing or resting).
+        #[test]
+        fn tangential_motion_matches_exact_arithmetic(
+            a in (1i64 << 25)..(1 << 29), b in (1i64 << 25)..(1 << 29), k in 1i64..16,
+            z in -8i64..=8, r_offset in -2i64..3, flip in any::<bool>(),
+        ) {
+            let a = if flip { -a } else { a };
+            let (u, w) = ([a, b, 1], [-k * b, k * a, z]);
+            let distance = ((a * a + b * b + 1) as f64).sqrt() as i64;
+            agrees(u, w, distance + r_offset, 12.0 * U)?;
+        }
     }
 }

@@ -8,8 +8,8 @@
 //!
 //! **Linear motion** (`A = 0`): `P(t) = a t² + 2 h t + c` with `a = |w|²`, `h = u₀·w`,
 //! `c = |u₀|² − r²`, a [`Quadratic`] whose descending root is the cancellation-free
-//! `t = c / (−h + √Δ)`, `Δ = h² − a c`. Its coefficients come from [`LinearSphere`]:
-//! plain arithmetic where a rigorous error bound proves them to `8 u`, double-double
+//! `t = c / (−h + √Δ)`, `Δ = h² − a c`. Its coefficients come from [`LinearSphere`], in
+//! `f64`: plain arithmetic where a rigorous error bound proves them to `8 u`, double-double
 //! otherwise (a gap of `10⁻¹²` survives in `c`, and a graze by `10⁻⁹` at a distance of
 //! `10⁶` in `Δ`, although `h² ≈ a c ≈ 10¹²` there).
 //!
@@ -75,8 +75,7 @@ impl<T: Real, const D: usize> SphereGap<T, D> {
     /// The first descent on `[lo, hi]` (`hi` may be `+∞`); `None` if a value overflowed.
     pub(crate) fn first_descent(&self, lo: T, hi: T, armed: bool) -> Option<Descent<T>> {
         if self.is_linear() {
-            self.linear_quadratic()
-                .map(|q| q.first_descent(lo, hi, armed))
+            self.linear_first_descent(lo, hi, armed)
         } else {
             self.quartic_first_descent(lo, hi, armed)
         }
@@ -88,9 +87,22 @@ impl<T: Real, const D: usize> SphereGap<T, D> {
         self.half_acceleration.iter().all(|&x| x == T::zero())
     }
 
-    /// `|u₀ + w t|² − r²` with accurate coefficients; `None` on overflow.
-    fn linear_quadratic(&self) -> Option<Quadratic<T>> {
-        LinearSphere::new(self.u0, self.w, self.radius).quadratic()
+    /// The first descent of the linear gap, solved in `f64` whatever `T` is (exact
+    /// products for `f32`) with coefficients accurate to `8u` in `f64`, or to a sixteenth
+    /// of `f32`'s unit roundoff for `f32`; `None` on overflow.
+    fn linear_first_descent(&self, lo: T, hi: T, armed: bool) -> Option<Descent<T>> {
+        let wide = |v: &Vector<T, D>| v.map(T::to_f64);
+        let budget = (4.0 * f64::EPSILON).max(T::EPSILON.to_f64() / 32.0);
+        let gap = LinearSphere::new(wide(&self.u0), wide(&self.w), self.radius.to_f64());
+        Some(
+            match gap
+                .quadratic(budget)?
+                .first_descent(lo.to_f64(), hi.to_f64(), armed)
+            {
+                Descent::At(s) => Descent::At(T::lit(s)),
+                Descent::Clear { armed } => Descent::Clear { armed },
+            },
+        )
     }
 
     fn quartic_first_descent(&self, lo: T, hi: T, armed: bool) -> Option<Descent<T>> {
@@ -109,9 +121,7 @@ impl<T: Real, const D: usize> SphereGap<T, D> {
         }
         if c[4] == T::zero() {
             // A underflowed in the squares: the motion is linear to working precision.
-            return self
-                .linear_quadratic()
-                .map(|q| q.first_descent(lo, hi, armed));
+            return self.linear_first_descent(lo, hi, armed);
         }
         let bound = fujiwara_bound(&c);
         let end = hi.min(bound);
