@@ -5,22 +5,30 @@
 //!
 //! * linear when both balls move at constant velocity, **or when both feel the same
 //!   acceleration** (a common gravity cancels): the closed form of DESIGN.md,
-//!   `t = c / (−b/2 + √(b²/4 − a c))`, decided by filtered arithmetic (`LinearSphere`:
-//!   plain floating point with a proven error bound, double-double only where the bound
-//!   cannot prove a sign or the root's accuracy). No linear fallback: a slow closing is
-//!   solved by the same formula, and `Δ <= 0` is a miss, never an invented collision;
+//!   `t = c / (−b/2 + √(b²/4 − a c))`, decided by filtered arithmetic (`LinearSphere`):
+//!   a quick test in the input precision sends receding and missing pairs away after a
+//!   few dot products; the rest is computed in `f64` (exact products for `f32` input)
+//!   with a proven error bound, and in double-double only where the bound cannot prove a
+//!   sign or the root's accuracy. No linear fallback: a slow closing is solved by the
+//!   same formula, and `Δ <= 0` is a miss, never an invented collision;
 //! * a quartic otherwise, solved by bracketing (see `SphereGap`).
 //!
-//! Cases, for `gap₀ = |u₀| − R` and the rate `u₀·w`:
+//! Cases, for the gap at time 0 and the rate `u₀·w`:
 //!
 //! | state at time 0                         | result                      |
 //! |-----------------------------------------|-----------------------------|
 //! | apart, closing and meeting              | `Hit` at the first contact  |
 //! | apart, receding or missing              | `NoHit`                     |
-//! | touching (`gap₀ = 0`), rate `< 0`       | `AlreadyTouching`, time 0   |
+//! | touching, rate `< 0`                    | `AlreadyTouching`, time 0   |
 //! | touching, rate `>= 0` (receding/resting)| `NoHit` (or a later hit under differing accelerations) |
 //! | overlapping, rate `< 0`                 | `AlreadyTouching`, time 0   |
 //! | overlapping, rate `>= 0`                | `NoHit` until they separate |
+//!
+//! Touching means that the centre distance rounds to `R`: for linear motion
+//! `|u₀|² − R² <= 2u fl(R²)` exactly (`u` the unit roundoff of `f64`), that is
+//! `|u₀| <= R (1 + u)` to first order; a gap of one ulp of `R` or more is a `Hit` at its
+//! exact time. The signs of the rate and of the gap are decided exactly (to the
+//! double-double resolution, `u²` of the terms).
 
 use carom_geometry::Ball;
 use carom_math::{Real, Vector};
