@@ -118,7 +118,10 @@ pub(crate) fn recedes_or_misses<T: Real, const D: usize>(
         a += w * w;
         s += u * u;
     }
-    if h * sign > magnitude * (T::from_count(D + 3) * unit) + T::MIN_POSITIVE {
+    // The plain sign first: this branch goes either way about half of the time, and it
+    // resolves as soon as `h` is known; its proof, almost always true, comes second.
+    let h = h * sign;
+    if h > T::zero() && h > magnitude * (T::from_count(D + 3) * unit) + T::MIN_POSITIVE {
         return true;
     }
     let r = r1 + r2;
@@ -227,7 +230,7 @@ impl<T: Real, const D: usize> LinearSphere<T, D> {
             h,
             a,
             c,
-            disc: discriminant::<T, D>(h, a, c),
+            disc: bounded_discriminant::<T, D>(h, a, c),
             rate_magnitude,
             gap_magnitude: s + q,
             touch: q * (unit + unit),
@@ -332,7 +335,7 @@ impl<T: Real, const D: usize> LinearSphere<T, D> {
         let sharp = Coefficients {
             h,
             c,
-            disc: discriminant::<T, D>(h, plain.a, c),
+            disc: bounded_discriminant::<T, D>(h, plain.a, c),
             ..*plain
         };
         (dd_h, dd_c, sharp)
@@ -381,7 +384,7 @@ impl<T: Real, const D: usize> LinearSphere<T, D> {
 
 /// `Δ̂ = fl(ĥ² − â ĉ)` and its bound `E_Δ` (module docs).
 #[inline]
-fn discriminant<T: Real, const D: usize>(h: Bounded<T>, a: T, c: Bounded<T>) -> Bounded<T> {
+fn bounded_discriminant<T: Real, const D: usize>(h: Bounded<T>, a: T, c: Bounded<T>) -> Bounded<T> {
     let unit = unit::<T>();
     let hh = h.value * h.value;
     let disc = hh - a * c.value;
