@@ -3,6 +3,17 @@
 //! reference. Each benchmark runs a batch of 1024 varied queries (hits and misses) so
 //! branch prediction sees a realistic mix; criterion reports time per query
 //! (`Throughput::Elements`).
+//!
+//! `ball_ball_gas` is the event-driven engine's inner loop: a 3D hard-sphere gas, each
+//! query a ball and one of its neighbour-list partners (centre distance between `R` and
+//! `1.5 R`, Maxwellian relative velocity), so about half recede and many of the rest
+//! miss.
+//!
+//! Instruction counts. With `TOI_COUNT=<group>/<name>` (and optionally `TOI_REPS`, default
+//! 100) the binary skips criterion and runs that one query batch `TOI_REPS` times in the
+//! function `counted`, for `valgrind --tool=callgrind --toggle-collect='*counted*'`:
+//! instructions per query are the collected total over `TOI_REPS × 1024` (see
+//! docs/toi.md). Instruction counts do not depend on the machine's load.
 
 use std::hint::black_box;
 
@@ -11,7 +22,7 @@ use carom::toi::{
     AdvanceOptions, Cluster, ConstantSpin, Kinematics, Window, ball_aabb, ball_ball, cluster_plane,
 };
 use criterion::measurement::WallTime;
-use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group};
 use nalgebra::{Rotation2, Vector1, Vector2, Vector3};
 
 const BATCH: usize = 1024;
@@ -66,23 +77,63 @@ fn pairs2(rng: &mut Lcg) -> Vec<Pair<Vector2<f32>>> {
         .collect()
 }
 
-/// Benchmarks `query` over a whole batch; the sum of the (capped) times keeps the work
-/// observable.
-fn run<Q>(
-    g: &mut BenchmarkGroup<'_, WallTime>,
-    name: &str,
-    batch: &[Q],
-    query: impl Fn(&Q) -> f64,
-) {
-    g.bench_function(name, |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for q in batch {
-                acc += query(black_box(q)).min(1e3);
+/// One batch of queries: the sum of the (capped) times keeps the work observable.
+fn batch_sum<Q>(batch: &[Q], query: &impl Fn(&Q) -> f64) -> f64 {
+    let mut acc = 0.0;
+    for q in batch {
+        acc += query(black_box(q)).min(1e3);
+    }
+    acc
+}
+
+/// The instruction-counting mode: the case named by `TOI_COUNT` and the repetitions.
+fn count_mode() -> Option<(String, usize)> {
+    let case = std::env::var("TOI_COUNT").ok()?;
+    let reps = std::env::var("TOI_REPS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(100);
+    Some((case, reps))
+}
+
+/// The batch repeated `reps` times, out of line so callgrind can collect just this.
+#[inline(never)]
+fn counted<Q>(batch: &[Q], query: &impl Fn(&Q) -> f64, reps: usize) -> f64 {
+    (0..reps).map(|_| batch_sum(batch, query)).sum()
+}
+
+/// A criterion group, or in counting mode the group's name only.
+struct Group<'c> {
+    name: &'static str,
+    timed: BenchmarkGroup<'c, WallTime>,
+}
+
+impl<'c> Group<'c> {
+    fn new(c: &'c mut Criterion, name: &'static str, elements: usize) -> Self {
+        let mut timed = c.benchmark_group(name);
+        timed.throughput(Throughput::Elements(elements as u64));
+        Self { name, timed }
+    }
+
+    /// Times `query` over the whole batch (or counts it, see the module docs).
+    fn run<Q>(&mut self, name: &str, batch: &[Q], query: impl Fn(&Q) -> f64) {
+        if let Some((case, reps)) = count_mode() {
+            if case == format!("{}/{name}", self.name) {
+                black_box(counted(batch, &query, reps));
             }
-            black_box(acc)
-        });
-    });
+            return;
+        }
+        self.timed
+            .bench_function(name, |b| b.iter(|| black_box(batch_sum(batch, &query))));
+    }
+
+    fn throughput(&mut self, elements: usize) {
+        self.timed.throughput(Throughput::Elements(elements as u64));
+    }
+
+    fn finish(self) {
+        self.timed.finish();
+    }
 }
 
 fn ball_ball_linear(c: &mut Criterion) {
@@ -106,9 +157,8 @@ fn ball_ball_linear(c: &mut Criterion) {
     );
     let o3 = parry3d::query::ShapeCastOptions::with_max_time_of_impact(10.0);
     let o2 = parry2d::query::ShapeCastOptions::with_max_time_of_impact(10.0);
-    let mut g = c.benchmark_group("ball_ball_linear");
-    g.throughput(Throughput::Elements(BATCH as u64));
-    run(&mut g, "carom_3d_f32", &q3, |q| {
+    let mut g = Group::new(c, "ball_ball_linear", BATCH);
+    g.run("carom_3d_f32", &q3, |q| {
         let (b1, b2) = (
             Ball::new_unchecked(Vector3::zeros(), q.r1),
             Ball::new_unchecked(q.p, q.r2),
@@ -116,7 +166,7 @@ fn ball_ball_linear(c: &mut Criterion) {
         let k2 = Kinematics::new_unchecked(q.v, Vector3::zeros());
         f64::from(ball_ball(&b1, &Kinematics::at_rest(), &b2, &k2, &w32).time)
     });
-    run(&mut g, "carom_3d_f64", &q64, |(p, v, r1, r2)| {
+    g.run("carom_3d_f64", &q64, |(p, v, r1, r2)| {
         let (b1, b2) = (
             Ball::new_unchecked(Vector3::zeros(), *r1),
             Ball::new_unchecked(*p, *r2),
@@ -124,7 +174,7 @@ fn ball_ball_linear(c: &mut Criterion) {
         let k2 = Kinematics::new_unchecked(*v, Vector3::zeros());
         ball_ball(&b1, &Kinematics::at_rest(), &b2, &k2, &w64).time
     });
-    run(&mut g, "parry3d_cast_shapes", &q3, |q| {
+    g.run("parry3d_cast_shapes", &q3, |q| {
         let (b1, b2) = (
             parry3d::shape::Ball::new(q.r1),
             parry3d::shape::Ball::new(q.r2),
@@ -141,7 +191,7 @@ fn ball_ball_linear(c: &mut Criterion) {
         );
         f64::from(hit.unwrap().map_or(1e3, |h| h.time_of_impact))
     });
-    run(&mut g, "carom_2d_f32", &q2, |q| {
+    g.run("carom_2d_f32", &q2, |q| {
         let (b1, b2) = (
             Ball::new_unchecked(Vector2::zeros(), q.r1),
             Ball::new_unchecked(q.p, q.r2),
@@ -149,7 +199,7 @@ fn ball_ball_linear(c: &mut Criterion) {
         let k2 = Kinematics::new_unchecked(q.v, Vector2::zeros());
         f64::from(ball_ball(&b1, &Kinematics::at_rest(), &b2, &k2, &w32).time)
     });
-    run(&mut g, "parry2d_cast_shapes", &q2, |q| {
+    g.run("parry2d_cast_shapes", &q2, |q| {
         let (b1, b2) = (
             parry2d::shape::Ball::new(q.r1),
             parry2d::shape::Ball::new(q.r2),
@@ -165,6 +215,43 @@ fn ball_ball_linear(c: &mut Criterion) {
             o2,
         );
         f64::from(hit.unwrap().map_or(1e3, |h| h.time_of_impact))
+    });
+    g.finish();
+}
+
+/// A 3D hard-sphere gas seen by the event-driven engine: each query is a ball and a
+/// neighbour-list partner (shell `1.5 R`), relative velocities the difference of two
+/// Maxwellian velocities (sums of uniforms), f64, no horizon.
+fn ball_ball_gas(c: &mut Criterion) {
+    let mut rng = Lcg(4);
+    let (r, shell) = (0.5_f64, 1.5_f64);
+    let gaussian = |rng: &mut Lcg| {
+        let s: f32 = (0..4).map(|_| rng.next(-1.0, 1.0)).sum();
+        f64::from(s)
+    };
+    let q: Vec<_> = (0..BATCH)
+        .map(|_| {
+            let dir = loop {
+                let d = rng.vec3(-1.0, 1.0).cast::<f64>();
+                let n = d.norm();
+                if n > 0.1 && n <= 1.0 {
+                    break d / n;
+                }
+            };
+            let dist = 2.0 * r * (1.0 + (shell - 1.0) * f64::from(rng.next(0.0, 1.0)));
+            let v = Vector3::from_fn(|_, _| gaussian(&mut rng));
+            (dir * dist, v)
+        })
+        .collect();
+    let w = Window::unbounded(carom::toi::Direction::Forward);
+    let mut g = Group::new(c, "ball_ball_gas", BATCH);
+    g.run("carom_3d_f64", &q, |(p, v)| {
+        let (b1, b2) = (
+            Ball::new_unchecked(Vector3::zeros(), r),
+            Ball::new_unchecked(*p, r),
+        );
+        let k2 = Kinematics::new_unchecked(*v, Vector3::zeros());
+        ball_ball(&b1, &Kinematics::at_rest(), &b2, &k2, &w).time
     });
     g.finish();
 }
@@ -194,9 +281,8 @@ fn ball_cuboid_linear(c: &mut Criterion) {
     let w = Window::forward(10.0_f32).unwrap();
     let o3 = parry3d::query::ShapeCastOptions::with_max_time_of_impact(10.0);
     let o2 = parry2d::query::ShapeCastOptions::with_max_time_of_impact(10.0);
-    let mut g = c.benchmark_group("ball_cuboid_linear");
-    g.throughput(Throughput::Elements(BATCH as u64));
-    run(&mut g, "carom_3d_f32", &q3, |(p, v, r, h)| {
+    let mut g = Group::new(c, "ball_cuboid_linear", BATCH);
+    g.run("carom_3d_f32", &q3, |(p, v, r, h)| {
         let k = Kinematics::new_unchecked(*v, Vector3::zeros());
         let toi = ball_aabb(
             &Ball::new_unchecked(*p, *r),
@@ -207,7 +293,7 @@ fn ball_cuboid_linear(c: &mut Criterion) {
         );
         f64::from(toi.time)
     });
-    run(&mut g, "parry3d_cast_shapes", &q3, |(p, v, r, h)| {
+    g.run("parry3d_cast_shapes", &q3, |(p, v, r, h)| {
         let (ball, cuboid) = (
             parry3d::shape::Ball::new(*r),
             parry3d::shape::Cuboid::new((*h).into()),
@@ -224,7 +310,7 @@ fn ball_cuboid_linear(c: &mut Criterion) {
         );
         f64::from(hit.unwrap().map_or(1e3, |h| h.time_of_impact))
     });
-    run(&mut g, "carom_2d_f32", &q2, |(p, v, r, h)| {
+    g.run("carom_2d_f32", &q2, |(p, v, r, h)| {
         let k = Kinematics::new_unchecked(*v, Vector2::zeros());
         let toi = ball_aabb(
             &Ball::new_unchecked(*p, *r),
@@ -235,7 +321,7 @@ fn ball_cuboid_linear(c: &mut Criterion) {
         );
         f64::from(toi.time)
     });
-    run(&mut g, "parry2d_cast_shapes", &q2, |(p, v, r, h)| {
+    g.run("parry2d_cast_shapes", &q2, |(p, v, r, h)| {
         let (ball, cuboid) = (
             parry2d::shape::Ball::new(*r),
             parry2d::shape::Cuboid::new((*h).into()),
@@ -270,9 +356,8 @@ fn reference(c: &mut Criterion) {
         })
         .collect();
     let w = Window::forward(10.0_f64).unwrap();
-    let mut g = c.benchmark_group("reference_f64");
-    g.throughput(Throughput::Elements(BATCH as u64));
-    run(&mut g, "ball_ball_3d_differing_gravity", &q, |(p, v, _)| {
+    let mut g = Group::new(c, "reference_f64", BATCH);
+    g.run("ball_ball_3d_differing_gravity", &q, |(p, v, _)| {
         let k = Kinematics::new_unchecked(*v, gravity);
         let (b1, b2) = (
             Ball::new_unchecked(Vector3::zeros(), 0.5),
@@ -280,7 +365,7 @@ fn reference(c: &mut Criterion) {
         );
         ball_ball(&b1, &Kinematics::at_rest(), &b2, &k, &w).time
     });
-    run(&mut g, "ball_box_3d_gravity", &q, |(p, v, h)| {
+    g.run("ball_box_3d_gravity", &q, |(p, v, h)| {
         let k = Kinematics::new_unchecked(*v, gravity);
         ball_aabb(
             &Ball::new_unchecked(*p, 0.3),
@@ -312,12 +397,24 @@ fn reference(c: &mut Criterion) {
             .unwrap()
         })
         .collect();
-    g.throughput(Throughput::Elements(motions.len() as u64));
-    run(&mut g, "cluster_wall_2d_spinning", &motions, |m| {
+    g.throughput(motions.len());
+    g.run("cluster_wall_2d_spinning", &motions, |m| {
         cluster_plane(&cluster, m, &wall, &w, &options).time
     });
     g.finish();
 }
 
-criterion_group!(benches, ball_ball_linear, ball_cuboid_linear, reference);
-criterion_main!(benches);
+criterion_group!(
+    benches,
+    ball_ball_linear,
+    ball_ball_gas,
+    ball_cuboid_linear,
+    reference
+);
+
+fn main() {
+    benches();
+    if count_mode().is_none() {
+        Criterion::default().configure_from_args().final_summary();
+    }
+}

@@ -5,26 +5,35 @@
 //!
 //! * linear when both balls move at constant velocity, **or when both feel the same
 //!   acceleration** (a common gravity cancels): the closed form of DESIGN.md,
-//!   `t = c / (−b/2 + √(b²/4 − a c))`, with the accurate `c` and discriminant described
-//!   in the `SphereGap` docs (no linear fallback: a slow closing is solved by the same
-//!   formula, and `Δ <= 0` is a miss, never an invented collision);
+//!   `t = c / (−b/2 + √(b²/4 − a c))`, decided by filtered arithmetic (`LinearSphere`):
+//!   a quick test in the input precision sends receding and missing pairs away after a
+//!   few dot products; the rest is computed in `f64` (exact products for `f32` input)
+//!   with a proven error bound, and in double-double only where the bound cannot prove a
+//!   sign or the root's accuracy. No linear fallback: a slow closing is solved by the
+//!   same formula, and `Δ <= 0` is a miss, never an invented collision;
 //! * a quartic otherwise, solved by bracketing (see `SphereGap`).
 //!
-//! Cases, for `gap₀ = |u₀| − R` and the rate `u₀·w`:
+//! Cases, for the gap at time 0 and the rate `u₀·w`:
 //!
 //! | state at time 0                         | result                      |
 //! |-----------------------------------------|-----------------------------|
 //! | apart, closing and meeting              | `Hit` at the first contact  |
 //! | apart, receding or missing              | `NoHit`                     |
-//! | touching (`gap₀ = 0`), rate `< 0`       | `AlreadyTouching`, time 0   |
+//! | touching, rate `< 0`                    | `AlreadyTouching`, time 0   |
 //! | touching, rate `>= 0` (receding/resting)| `NoHit` (or a later hit under differing accelerations) |
 //! | overlapping, rate `< 0`                 | `AlreadyTouching`, time 0   |
 //! | overlapping, rate `>= 0`                | `NoHit` until they separate |
+//!
+//! Touching means that the centre distance rounds to `R`: for linear motion
+//! `|u₀|² − R² <= 2u fl(R²)` exactly (`u` the unit roundoff of `f64`), that is
+//! `|u₀| <= R (1 + u)` to first order; a gap of one ulp of `R` or more is a `Hit` at its
+//! exact time. The signs of the rate and of the gap are decided exactly (to the
+//! double-double resolution, `u²` of the terms).
 
 use carom_geometry::Ball;
 use carom_math::{Real, Vector};
 
-use crate::roots::{Descent, SphereGap};
+use crate::roots::{Descent, LinearContact, LinearSphere, SphereGap, recedes_or_misses};
 use crate::{Kinematics, Status, Toi, Window};
 
 /// The first contact of two balls moving with constant accelerations (zero for linear
@@ -55,10 +64,98 @@ pub fn ball_ball<T: Real, const D: usize>(
     motion2: &Kinematics<T, D>,
     window: &Window<T>,
 ) -> Toi<T, D> {
-    let direction = window.direction();
+    let accelerations = motion2.acceleration() - motion1.acceleration();
+    if accelerations.iter().fold(T::zero(), |sum, x| sum + x.abs()) != T::zero() {
+        return ballistic_ball_ball(ball1, motion1, ball2, motion2, window);
+    }
+    // Linear relative motion (equal accelerations cancel). Receding and missing pairs,
+    // most of all, leave after a few dot products in the input precision, without a
+    // square root; the rest continues in f64, out of line.
+    if recedes_or_misses(
+        (&ball1.center(), &ball2.center()),
+        (&motion1.velocity(), &motion2.velocity()),
+        (ball1.radius(), ball2.radius()),
+        window.direction().sign(),
+    ) {
+        return Toi::no_hit(window.direction().sign(), ());
+    }
+    linear_ball_ball(ball1, motion1, ball2, motion2, window)
+}
+
+/// A linear pair not proven to recede or miss, computed in `f64` whatever `T` is: for
+/// `f32` input every difference and product is then exact, for `f64` it is the working
+/// precision.
+#[inline(never)]
+fn linear_ball_ball<T: Real, const D: usize>(
+    ball1: &Ball<T, D>,
+    motion1: &Kinematics<T, D>,
+    ball2: &Ball<T, D>,
+    motion2: &Kinematics<T, D>,
+    window: &Window<T>,
+) -> Toi<T, D> {
+    // Computed in f64 whatever `T` is: for f32 input every difference and product is
+    // then exact, for f64 it is the working precision.
+    let wide = |v: Vector<T, D>| v.map(T::to_f64);
+    let gap = LinearSphere::new(
+        wide(ball2.center()) - wide(ball1.center()),
+        window
+            .direction()
+            .orient(&(wide(motion2.velocity()) - wide(motion1.velocity()))),
+        ball1.radius().to_f64() + ball2.radius().to_f64(),
+    );
+    // The root's error budget: 12 u in f64; for f32 output a sixteenth of its unit
+    // roundoff, so that the final rounding to f32 is the only visible error.
+    let budget = (6.0 * f64::EPSILON).max(T::EPSILON.to_f64() / 32.0);
+    match gap.first_contact(window.horizon().to_f64(), budget) {
+        LinearContact::Clear => Toi::no_hit(window.direction().sign(), ()),
+        LinearContact::At(s) => linear_contact(Status::Hit, s, &gap, ball1, motion1, window),
+        LinearContact::Immediate => {
+            linear_contact(Status::AlreadyTouching, 0.0, &gap, ball1, motion1, window)
+        }
+        LinearContact::Overflow => Toi::not_converged(T::zero(), ()),
+    }
+}
+
+/// The contact of a linear pair at search time `s`: two square roots in all (the root
+/// and the normal's length).
+fn linear_contact<T: Real, const D: usize>(
+    status: Status,
+    s: f64,
+    gap: &LinearSphere<f64, D>,
+    ball1: &Ball<T, D>,
+    motion1: &Kinematics<T, D>,
+    window: &Window<T>,
+) -> Toi<T, D> {
+    let t = window.signed(T::lit(s));
+    let offset = gap.offset(s);
+    let dist = offset.norm();
+    let normal = unit_or(&offset, dist, gap.velocity());
+    let r1 = ball1.radius().to_f64();
+    Toi {
+        status,
+        time: t,
+        normal: normal.map(T::lit),
+        point: ball1.center()
+            + motion1.displacement(t)
+            + (normal * (r1 + (dist - gap.radius()) * 0.5)).map(T::lit),
+        feature: (),
+    }
+}
+
+/// Differing accelerations: the quartic gap of `SphereGap`.
+#[inline(never)]
+fn ballistic_ball_ball<T: Real, const D: usize>(
+    ball1: &Ball<T, D>,
+    motion1: &Kinematics<T, D>,
+    ball2: &Ball<T, D>,
+    motion2: &Kinematics<T, D>,
+    window: &Window<T>,
+) -> Toi<T, D> {
     let gap = SphereGap::new(
         ball2.center() - ball1.center(),
-        direction.orient(&(motion2.velocity() - motion1.velocity())),
+        window
+            .direction()
+            .orient(&(motion2.velocity() - motion1.velocity())),
         (motion2.acceleration() - motion1.acceleration()) * T::lit(0.5),
         ball1.radius() + ball2.radius(),
     );
@@ -78,22 +175,10 @@ pub fn ball_ball<T: Real, const D: usize>(
             feature: (),
         }
     };
-    let descent = if gap.is_linear() {
-        // Receding pairs leave before any square root; a closing pair in contact has a
-        // descending root <= 0 and is immediate.
-        match gap.linear_first_contact(window.horizon()) {
-            Some(Descent::At(s)) if s == T::zero() || gap.gap(T::zero()) <= T::zero() => {
-                return contact(Status::AlreadyTouching, T::zero());
-            }
-            other => other,
-        }
-    } else {
-        if gap.closing_at_start() {
-            return contact(Status::AlreadyTouching, T::zero());
-        }
-        gap.first_descent(T::zero(), window.horizon(), gap.gap(T::zero()) > T::zero())
-    };
-    match descent {
+    if gap.closing_at_start() {
+        return contact(Status::AlreadyTouching, T::zero());
+    }
+    match gap.first_descent(T::zero(), window.horizon(), gap.gap(T::zero()) > T::zero()) {
         Some(Descent::At(s)) => contact(Status::Hit, s),
         Some(Descent::Clear { .. }) => Toi::no_hit(window.direction().sign(), ()),
         None => Toi::not_converged(T::zero(), ()),

@@ -8,11 +8,11 @@
 //!
 //! | query | bodies | method |
 //! |---|---|---|
-//! | [`ball_ball`] | two balls, linear, same or differing constant accelerations | cancellation-free quadratic root; quartic with bracketed roots |
+//! | [`ball_ball`] | two balls, linear, same or differing constant accelerations | filtered cancellation-free quadratic root (plain arithmetic with proven bounds, double-double fallback); quartic with bracketed roots |
 //! | [`ball_plane`] | ball and a static half-space, linear or under gravity | quadratic |
 //! | [`ball_border`] | ball inside a reflecting [`Border`](carom_geometry::Border): the first wall | quadratic per wall |
 //! | [`plane_crossing`], [`level_crossing`] | a centre crossing a plane or a level (periodic cell faces) | quadratic |
-//! | [`ball_aabb`], [`ball_obb`] | ball and a translating box: faces, edges, corners | region walk, closed forms and bracketed quartics |
+//! | [`ball_aabb`], [`ball_obb`] | ball and a translating box: faces, edges, corners | slab early-out and direct face test; region walk, closed forms and bracketed quartics |
 //! | [`cluster_plane`], [`cluster_border`], [`cluster_ball`], [`cluster_cluster`] | a rotating rigid cluster of balls | conservative advancement, then ITP |
 //!
 //! Conventions (see [`Toi`]): times are signed offsets from now (`>= 0` forward,

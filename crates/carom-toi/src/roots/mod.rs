@@ -8,12 +8,15 @@
 //! collide again.
 
 mod descent;
+mod exact;
 mod itp;
+mod linear;
 mod quadratic;
 mod sphere;
 
 pub(crate) use descent::{Descent, first_descent_monotone};
 pub(crate) use itp::itp;
+pub(crate) use linear::{LinearContact, LinearSphere, recedes_or_misses};
 pub(crate) use quadratic::Quadratic;
 pub(crate) use sphere::SphereGap;
 

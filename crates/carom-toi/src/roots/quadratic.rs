@@ -11,17 +11,36 @@
 //! ```
 //!
 //! so neither form subtracts nearly equal numbers (no cancellation), and `a = 0` (a
-//! linear gap `2 h t + c`) is the first form with `√Δ = |h|`. `Δ` itself is computed with
-//! Kahan's difference of products, or supplied by the caller when a better formula is
-//! known (the miss distance of two balls). `Δ <= 0` means a tangency or no real root:
-//! no descending crossing.
+//! linear gap `2 h t + c`) is the first form with `√Δ = |h|`. `Δ` itself is computed to
+//! within `3u` (see [`discriminant`]), or supplied by the caller when a better evaluation
+//! is known (two balls: `LinearSphere`). `Δ <= 0` means a tangency or no real root: no
+//! descending crossing.
 //!
 //! A quadratic has at most one descending root, so its first descent on an interval is
 //! that root if it lies inside.
 
-use carom_math::{Real, robust::diff_of_products};
+use carom_math::Real;
 
 use super::Descent;
+use super::exact::{two_product, two_square, two_sum};
+
+/// `h² − a c` to within `3u` (`u` the unit roundoff), without the libm `fma` calls of
+/// Kahan's algorithm on targets without hardware FMA. The plain `fl(fl(h²) − fl(a c))` errs
+/// by at most `u (h² + |a c|) + u |Δ̂|`: when `h² + |a c| <= 2 |Δ̂|` (no cancellation,
+/// which includes every `a c < 0`) that is `3u |Δ̂|` and it is kept. Otherwise the two
+/// products are split exactly (`p + e = h²`, `q + f = a c`), `p − q` is summed without
+/// error, and `Δ = (p − q) + ((e − f) + error)` is rounded once: within `u |Δ|` plus `u²`
+/// of the products.
+pub(crate) fn discriminant<T: Real>(h: T, a: T, c: T) -> T {
+    let (hh, ac) = (h * h, a * c);
+    let plain = hh - ac;
+    if hh + ac.abs() <= plain.abs() * T::lit(2.0) {
+        return plain;
+    }
+    let ((p, e), (q, f)) = (two_square(h), two_product(a, c));
+    let (s, g) = two_sum(p, -q);
+    s + (g + (e - f))
+}
 
 /// `f(t) = a t² + 2 h t + c` with its discriminant `Δ = h² − a c`.
 #[derive(Clone, Copy, Debug)]
@@ -33,15 +52,14 @@ pub(crate) struct Quadratic<T: Real> {
 }
 
 impl<T: Real> Quadratic<T> {
-    /// The quadratic `a t² + 2 h t + c`, its discriminant by Kahan's algorithm (`h²`
-    /// exactly rounded when `a = 0`: a linear gap has nothing to cancel, and skipping the
-    /// fused multiply-adds matters where the target has no hardware FMA).
+    /// The quadratic `a t² + 2 h t + c`, its discriminant by [`discriminant`] (`h²`
+    /// exactly rounded when `a = 0`: a linear gap has nothing to cancel).
     #[inline]
     pub(crate) fn new(a: T, h: T, c: T) -> Self {
         let disc = if a == T::zero() {
             h * h
         } else {
-            diff_of_products(h, h, a, c)
+            discriminant(h, a, c)
         };
         Self { a, h, c, disc }
     }
@@ -173,6 +191,33 @@ mod tests {
         assert_eq!(Quadratic::new(0.0, 0.5, 2.0).descending_root(), None);
         // Tangency (t − 1)²: none.
         assert_eq!(Quadratic::new(1.0, -1.0, 1.0).descending_root(), None);
+    }
+
+    #[test]
+    fn discriminant_survives_cancellation() {
+        // h² − a c with h² and a c equal to 53 bits: (1 + 2^-30)(1 − 2^-30) = 1 − 2^-60.
+        let (a, c) = (1.0 + 2f64.powi(-30), 1.0 - 2f64.powi(-30));
+        assert_eq!(a * c - 1.0, 0.0);
+        assert_eq!(discriminant(1.0, a, c), 2f64.powi(-60));
+        assert_eq!(discriminant(3.0, 2.0, -4.0), 17.0);
+        assert_eq!(discriminant(3.0_f32, 2.0, 4.0), 1.0);
+    }
+
+    proptest::proptest! {
+        /// Against exact integer arithmetic, with `c` chosen so that `a c ≈ h²` (heavy
+        /// cancellation) half of the time.
+        #[test]
+        fn discriminant_is_within_three_u(
+            h in -(1i64 << 30)..(1 << 30), a in 1i64..(1 << 30), c in -(1i64 << 30)..(1 << 30),
+            delta in -64i64..64, cancel in proptest::bool::ANY,
+        ) {
+            let c = if cancel { (h * h) / a + delta } else { c };
+            let exact = i128::from(h) * i128::from(h) - i128::from(a) * i128::from(c);
+            let got = discriminant(h as f64, a as f64, c as f64);
+            // Every value here is an integer: compare exactly.
+            let err = (got as i128 - exact).unsigned_abs() as f64;
+            proptest::prop_assert!(err <= 1.5 * f64::EPSILON * exact.unsigned_abs() as f64, "{got} vs {exact}");
+        }
     }
 
     #[test]

@@ -8,19 +8,10 @@
 //!
 //! **Linear motion** (`A = 0`): `P(t) = a t² + 2 h t + c` with `a = |w|²`, `h = u₀·w`,
 //! `c = |u₀|² − r²`, a [`Quadratic`] whose descending root is the cancellation-free
-//! `t = c / (−h + √Δ)`. Two refinements keep it exact in the hard cases:
-//!
-//! * `c = (|u₀| − r)(|u₀| + r)`: for a gap of `10⁻¹²` the subtraction `|u₀| − r` is exact
-//!   when both are within a factor 2 (Sterbenz), where `|u₀|² − r²` would lose the gap to
-//!   the rounding of the squares.
-//! * `Δ = h² − a c = |w|² r² − |u₀ ∧ w|²` (Lagrange's identity), with
-//!   `|u₀ ∧ w|² = Σᵢ<ⱼ (u₀ᵢ wⱼ − u₀ⱼ wᵢ)²`. Each wedge term is a plain difference of
-//!   products: its rounding, `ε |u₀| |w|`, is the size of the rounding already in `u₀`
-//!   at that distance, so Kahan's exact version (two fused multiply-adds per term,
-//!   libm calls of ~10 ns on targets without hardware FMA) would buy nothing here.
-//!   `|u₀ ∧ w| / |w|` is the miss distance, so `Δ = |w|² (r − m)(r + m)`: grazing by
-//!   `10⁻⁹` is decided by comparing `m` with `r`, not by subtracting `h² ≈ a c`, which at
-//!   a distance of `10⁶` are `10¹²` and would bury the answer in rounding.
+//! `t = c / (−h + √Δ)`, `Δ = h² − a c`. Its coefficients come from [`LinearSphere`], in
+//! `f64`: plain arithmetic where a rigorous error bound proves them to `8 u`, double-double
+//! otherwise (a gap of `10⁻¹²` survives in `c`, and a graze by `10⁻⁹` at a distance of
+//! `10⁶` in `Δ`, although `h² ≈ a c ≈ 10¹²` there).
 //!
 //! **Constant relative acceleration** (`A ≠ 0`): `P` is a quartic
 //! `|A|² t⁴ + 2 A·w t³ + (|w|² + 2 A·u₀) t² + 2 u₀·w t + c`. Its critical points are the
@@ -33,7 +24,7 @@
 
 use carom_math::{Real, Vector};
 
-use super::{Descent, Quadratic, first_descent_monotone, itp};
+use super::{Descent, LinearSphere, Quadratic, first_descent_monotone, itp};
 
 /// `g(t) = |u₀ + w t + A t²| − r`.
 #[derive(Clone, Copy, Debug)]
@@ -84,8 +75,7 @@ impl<T: Real, const D: usize> SphereGap<T, D> {
     /// The first descent on `[lo, hi]` (`hi` may be `+∞`); `None` if a value overflowed.
     pub(crate) fn first_descent(&self, lo: T, hi: T, armed: bool) -> Option<Descent<T>> {
         if self.is_linear() {
-            let q = self.linear_quadratic();
-            q.is_finite().then(|| q.first_descent(lo, hi, armed))
+            self.linear_first_descent(lo, hi, armed)
         } else {
             self.quartic_first_descent(lo, hi, armed)
         }
@@ -97,44 +87,21 @@ impl<T: Real, const D: usize> SphereGap<T, D> {
         self.half_acceleration.iter().all(|&x| x == T::zero())
     }
 
-    /// Linear motion, starting apart or not: the closed form with early exits (no square
-    /// root for a receding pair, which is half of all pairs). `None` on overflow.
-    #[inline]
-    pub(crate) fn linear_first_contact(&self, hi: T) -> Option<Descent<T>> {
-        debug_assert!(self.is_linear());
-        // A linear |u|² is convex: once it is not decreasing it never closes again.
-        if self.u0.dot(&self.w) >= T::zero() {
-            return Some(Descent::Clear { armed: true });
-        }
-        let q = self.linear_quadratic();
-        if !q.is_finite() {
-            return None;
-        }
-        Some(match q.descending_root() {
-            Some(s) if s <= hi => Descent::At(s.max(T::zero())),
-            _ => Descent::Clear { armed: true },
-        })
-    }
-
-    /// `|u₀ + w t|² − r²` with the accurate constant term and discriminant (module docs).
-    fn linear_quadratic(&self) -> Quadratic<T> {
-        let (u, w, r) = (&self.u0, &self.w, self.radius);
-        let dist = u.norm();
-        let speed = w.norm();
-        let mut wedge_sq = T::zero();
-        for i in 0..D {
-            for j in i + 1..D {
-                let term = u[i] * w[j] - u[j] * w[i];
-                wedge_sq += term * term;
-            }
-        }
-        let wedge = wedge_sq.sqrt();
-        let reach = speed * r;
-        Quadratic::with_discriminant(
-            speed * speed,
-            u.dot(w),
-            (dist - r) * (dist + r),
-            (reach - wedge) * (reach + wedge),
+    /// The first descent of the linear gap, solved in `f64` whatever `T` is (exact
+    /// products for `f32`) with coefficients accurate to `8u` in `f64`, or to a sixteenth
+    /// of `f32`'s unit roundoff for `f32`; `None` on overflow.
+    fn linear_first_descent(&self, lo: T, hi: T, armed: bool) -> Option<Descent<T>> {
+        let wide = |v: &Vector<T, D>| v.map(T::to_f64);
+        let budget = (4.0 * f64::EPSILON).max(T::EPSILON.to_f64() / 32.0);
+        let gap = LinearSphere::new(wide(&self.u0), wide(&self.w), self.radius.to_f64());
+        Some(
+            match gap
+                .quadratic(budget)?
+                .first_descent(lo.to_f64(), hi.to_f64(), armed)
+            {
+                Descent::At(s) => Descent::At(T::lit(s)),
+                Descent::Clear { armed } => Descent::Clear { armed },
+            },
         )
     }
 
@@ -154,8 +121,7 @@ impl<T: Real, const D: usize> SphereGap<T, D> {
         }
         if c[4] == T::zero() {
             // A underflowed in the squares: the motion is linear to working precision.
-            let q = self.linear_quadratic();
-            return q.is_finite().then(|| q.first_descent(lo, hi, armed));
+            return self.linear_first_descent(lo, hi, armed);
         }
         let bound = fujiwara_bound(&c);
         let end = hi.min(bound);

@@ -23,17 +23,26 @@
 //! handles every case with one loop: linear or ballistic, 2D or 3D, starting apart,
 //! touching, or overlapping and leaving (a ballistic ball can leave and come back).
 //!
+//! Linear motion first takes the early exits of `entry`: the slab test against the box
+//! grown by `r` (most misses leave there, without a square root), and Ericson's direct
+//! face test at the entry into the grown box (most face hits). What remains, entries near
+//! an edge or a corner and balls starting within the grown box, is walked, and only over
+//! the interval in which the centre is inside the grown box.
+//!
 //! Guarantees: at most `4·D` breakpoints and `4·D + 1` intervals; each interval's answer
 //! is a closed form or a bracketed ITP refinement on a monotone piece (never an
 //! unbracketed Newton step), so a contact is never skipped, and a tangency (a graze that
 //! touches without entering) is not reported. Contacts are found to machine precision in
 //! time; the interval walk adds no approximation.
 
+mod entry;
+
 use carom_geometry::{Aabb, Ball, Obb};
 use carom_math::{Real, Rotation, Vector};
 
 use crate::roots::{Descent, Quadratic, SphereGap, closing};
 use crate::{BoxFeature, Kinematics, Status, Toi, Window};
+use entry::Entry;
 
 /// The first contact of a ball with an axis-aligned box. `box_motion` is the box's own
 /// (non-rotating) motion; only the relative motion matters.
@@ -140,6 +149,7 @@ impl<T: Real, const D: usize> BoxFrame<'_, T, D> {
 }
 
 /// What the interval walk found.
+#[derive(Clone, Copy, Debug, PartialEq)]
 enum Event<T> {
     Immediate(BoxFeature),
     At(T, BoxFeature),
@@ -238,8 +248,9 @@ impl<T: Real, const D: usize> LocalMotion<T, D> {
         }
     }
 
-    /// The times in `(0, hi)` where the centre crosses a slab boundary `xᵢ = ±hᵢ`, sorted.
-    fn breakpoints(&self, hi: T) -> ([T; 12], usize) {
+    /// The times in `(lo, hi)` where the centre crosses a slab boundary `xᵢ = ±hᵢ`,
+    /// sorted.
+    fn breakpoints(&self, lo: T, hi: T) -> ([T; 12], usize) {
         let mut out = [T::zero(); 12];
         let mut n = 0;
         let half = T::lit(0.5);
@@ -252,7 +263,7 @@ impl<T: Real, const D: usize> LocalMotion<T, D> {
                 );
                 let (roots, m) = q.roots();
                 for &t in &roots[..m] {
-                    if t > T::zero() && t < hi && n < out.len() {
+                    if t > lo && t < hi && n < out.len() {
                         out[n] = t;
                         n += 1;
                     }
@@ -271,21 +282,54 @@ impl<T: Real, const D: usize> LocalMotion<T, D> {
     }
 
     fn first_contact(&self, hi: T) -> Event<T> {
-        if self
-            .x0
-            .iter()
-            .chain(self.w.iter())
-            .chain(self.half_acceleration.iter())
-            .any(|x| !x.finite())
-        {
+        let finite = |i: usize| {
+            self.x0[i].finite() && self.w[i].finite() && self.half_acceleration[i].finite()
+        };
+        if !(0..D).all(finite) {
             return Event::Overflow;
         }
-        let (breaks, n) = self.breakpoints(hi);
-        let ends = breaks[..n].iter().copied().chain(core::iter::once(hi));
+        if self.half_acceleration.iter().all(|&a| a == T::zero()) {
+            // Linear: the slab test and the direct face test first (`entry`).
+            match entry::slab_entry(&self.x0, &self.w, &self.h, self.r, hi) {
+                Entry::Never => return Event::Clear,
+                Entry::Inside => {}
+                Entry::Between { from, to, axis } => {
+                    let face = entry::face_contact(&self.x0, &self.w, &self.h, self.r, axis, hi);
+                    if let Some(t) = face {
+                        return Event::At(t, BoxFeature::from_outside_axes(1, D));
+                    }
+                    // Apart before `from`, never touching after `to`: walk from the last
+                    // region boundary before `from` (armed), exactly as the full walk
+                    // does from there on, and stop at `to`.
+                    let (breaks, n) = self.breakpoints(T::zero(), to);
+                    let start = breaks[..n].iter().rposition(|&b| b <= from);
+                    let lo = start.map_or(T::zero(), |k| breaks[k]);
+                    return self.walk_from(
+                        &breaks[start.map_or(0, |k| k + 1)..n],
+                        lo,
+                        to,
+                        T::one(),
+                    );
+                }
+            }
+        }
         let q0 = self.x0.inf(&self.h).sup(&-self.h);
-        let gap0 = (self.x0 - q0).norm() - self.r;
-        let mut armed = gap0 > T::zero();
-        let mut lo = T::zero();
+        self.walk(T::zero(), hi, (self.x0 - q0).norm() - self.r)
+    }
+
+    /// The region walk on `[lo, hi]`: `gap_lo` is the gap at `lo` (any positive value
+    /// when only its sign is known); at `lo = 0` a touching or overlapping start is
+    /// decided by the rate of the region it moves into.
+    fn walk(&self, lo: T, hi: T, gap_lo: T) -> Event<T> {
+        let (breaks, n) = self.breakpoints(lo, hi);
+        self.walk_from(&breaks[..n], lo, hi, gap_lo)
+    }
+
+    /// [`walk`](Self::walk) given the region boundaries in `(lo, hi)`, sorted.
+    fn walk_from(&self, breaks: &[T], lo: T, hi: T, gap_lo: T) -> Event<T> {
+        let ends = breaks.iter().copied().chain(core::iter::once(hi));
+        let mut armed = gap_lo > T::zero();
+        let mut lo = lo;
         for (k, end) in ends.enumerate() {
             if end <= lo && k > 0 {
                 continue;
@@ -298,7 +342,7 @@ impl<T: Real, const D: usize> LocalMotion<T, D> {
             let (signs, outside) = self.region(probe);
             let feature = BoxFeature::from_outside_axes(outside, D);
             let region = self.region_gap(&signs, outside);
-            if k == 0 && gap0 <= T::zero() && self.closing_at_start(&region, gap0) {
+            if k == 0 && gap_lo <= T::zero() && self.closing_at_start(&region, gap_lo) {
                 let at_start = BoxFeature::from_outside_axes(self.region(T::zero()).1, D);
                 return Event::Immediate(at_start);
             }
@@ -338,5 +382,85 @@ impl<T: Real, const D: usize> LocalMotion<T, D> {
                 closing(gap0, n.dot(&self.w), n.dot(&self.half_acceleration))
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The full walk from time 0, without the early exits.
+    fn walked<const D: usize>(m: &LocalMotion<f64, D>, hi: f64) -> Event<f64> {
+        let q0 = m.x0.inf(&m.h).sup(&-m.h);
+        m.walk(0.0, hi, (m.x0 - q0).norm() - m.r)
+    }
+
+    fn motion<const D: usize>(
+        x0: [f64; D],
+        w: [f64; D],
+        h: [f64; D],
+        r: f64,
+    ) -> LocalMotion<f64, D> {
+        LocalMotion {
+            x0: Vector::from(x0),
+            w: Vector::from(w),
+            half_acceleration: Vector::zeros(),
+            h: Vector::from(h),
+            r,
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3000))]
+
+        /// The slab test and the direct face test change nothing: the same event, time
+        /// and feature as walking every region from time 0 (3D).
+        #[test]
+        fn early_exits_agree_with_the_full_walk_3d(
+            x0 in prop::array::uniform3(-6.0..6.0f64), w in prop::array::uniform3(-3.0..3.0f64),
+            h in prop::array::uniform3(0.1..1.5f64), r in 0.05..1.0f64, hi in 0.5..20.0f64,
+        ) {
+            let m = motion(x0, w, h, r);
+            prop_assert_eq!(m.first_contact(hi), walked(&m, hi));
+        }
+
+        /// The same in 2D, with velocities along an axis (parallel to a face), entries
+        /// aimed at the corner of the grown box, and entries at the end of a face, where
+        /// the face test must leave the decision to the walk.
+        #[test]
+        fn early_exits_agree_with_the_full_walk_2d(
+            x0 in prop::array::uniform2(-6.0..6.0f64), w in prop::array::uniform2(-3.0..3.0f64),
+            h in prop::array::uniform2(0.1..1.5f64), r in 0.05..1.0f64, aim in 0..4,
+        ) {
+            let (mut x0, mut w) = (x0, w);
+            match aim {
+                // Parallel to the x faces.
+                0 => w[1] = 0.0,
+                // At the corner of the grown box: y = ±(h + r) on entry.
+                1 => x0[1] = (h[1] + r).copysign(x0[1]),
+                // At the end of the x face: y = ±h when x enters the grown slab.
+                2 => {
+                    let t = (x0[0].abs() - h[0] - r) / w[0].abs();
+                    x0[1] = h[1].copysign(x0[1]) - w[1] * t;
+                }
+                _ => {}
+            }
+            let m = motion(x0, w, h, r);
+            prop_assert_eq!(m.first_contact(f64::INFINITY), walked(&m, f64::INFINITY));
+        }
+    }
+
+    #[test]
+    fn a_face_hit_leaves_at_the_face_test_and_a_miss_at_the_slab_test() {
+        let m = motion([-4.0, 0.3], [2.0, 0.0], [1.0, 1.0], 0.5);
+        assert_eq!(m.first_contact(10.0), Event::At(1.25, BoxFeature::Face));
+        let miss = motion([-4.0, 1.6], [2.0, 0.0], [1.0, 1.0], 0.5);
+        assert_eq!(miss.first_contact(10.0), Event::Clear);
+        let corner = motion([-4.0, 1.3, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 1.0], 0.5);
+        assert!(matches!(
+            corner.first_contact(10.0),
+            Event::At(_, BoxFeature::Edge)
+        ));
     }
 }

@@ -1,0 +1,687 @@
+//! The linear sphere gap `P(t) = |u + w t|² − r² = a t² + 2 h t + c` (`a = |w|²`,
+//! `h = u·w`, `c = |u|² − r²`, `Δ = h² − a c`), decided by filtered arithmetic: plain
+//! floating point with a rigorous error bound, and double-double only where the bound
+//! cannot prove a sign or the accuracy of the root.
+//!
+//! This is the inner loop of the event-driven engine (every collision predicts about two
+//! dozen pairs, most of them receding or missing), so the common cases must be cheap:
+//!
+//! | pair | work |
+//! |---|---|
+//! | receding (`h` certainly `> 0`) | one dot product and its magnitude, in the input precision: no square root, no FMA |
+//! | missing (`Δ` certainly `< 0`) | three dot products, in the input precision: no square root |
+//! | hitting, root proven to the budget | plain coefficients and bounds, one square root, one division |
+//! | root not proven (near touching, glancing) | `h` and `c` in double-double, `Δ` recomputed from them |
+//! | still not proven (near grazing, far away) | `a` and `Δ = h² − a c` in double-double too |
+//!
+//! A pair is only ever decided on a proven sign, so the answer is that of exact
+//! arithmetic on the given `u`, `w`, `r`, up to the double-double evaluation's own
+//! resolution: about `u²` times the magnitudes of the terms, far below the rounding of the
+//! inputs themselves. The root is within `β + 3u` of exact, `β` the caller's budget
+//! (`ball_ball`: `12u` in `f64`, a sixteenth of `f32`'s unit roundoff for `f32` output),
+//! and within about `6u` when `Δ` is computed in double-double.
+//!
+//! # Error bounds
+//!
+//! `u` is the unit roundoff (`ε/2`), `γ_n = n u / (1 − n u)`, hats are computed values,
+//! `fl(x ∘ y) = (x ∘ y)(1 + δ)` with `|δ| <= u`. Recursive summation of `n` products has
+//! `|fl(Σ xᵢyᵢ) − Σ xᵢyᵢ| <= γ_n Σ |xᵢyᵢ|` (Higham, *Accuracy and Stability of Numerical
+//! Algorithms*, §3.1). Bounds are evaluated in floating point from computed magnitudes,
+//! which are at least `1 − γ_k` of the exact ones after `k` operations; each coefficient
+//! below is rounded up by at least one `u` (or the bound multiplied by `1 + 16u`), which
+//! covers that, every second-order term, and the one rounding of the comparison in which
+//! the bound is used. `T::MIN_POSITIVE` is added to every bound: it covers the absolute
+//! error of products that underflow (at most half the smallest subnormal each), so the
+//! filter stays rigorous for tiny inputs, which simply fall back.
+//!
+//! * **Quick test** ([`recedes_or_misses`], in the input precision, from the centres,
+//!   velocities and radii). The differences `û = fl(c₂ − c₁)`, `ŵ = fl(v₂ − v₁)`,
+//!   `R̂ = fl(r₁ + r₂)` are within `u` (relative, per component) of the exact ones.
+//!   *Rate*: `|h − fl(û·ŵ)| <= (2u + u² + γ_D (1 + 2u)) A`, `A = Σ|ûᵢŵᵢ|`, bounded by
+//!   `(D + 3) u Â`; `ĥ > (D + 3) u Â` proves a receding pair. *Miss*: with `s = |u|²`,
+//!   `q = R²`, the exact `Δ` moves by at most `u a (8.8 s + 4.3 q)` under the rounding of
+//!   the differences (using `A² <= s a`) and its plain evaluation errs by at most
+//!   `u a (17.9 s + 7.3 q)` (the terms of `E_Δ` below, each bounded through `A² <= s a`
+//!   and `|c| <= s + q`); `Δ̂ < −32 u â (ŝ + q̂)` proves `Δ < 0`, a miss (`Δ < 0` also
+//!   implies `c > 0`: apart, and never touching).
+//! * **Rate** (`f64`, on the exact differences). `|ĥ − h| <= γ_D Σ|uᵢ wᵢ|`, bounded by
+//!   `E_h = (D + 1) u fl(Σ|uᵢwᵢ|)`; `|ĥ| <= E_h` falls back.
+//! * **Gap.** `ŝ = fl(Σ uᵢ²)`, `q̂ = fl(r²)`, `ĉ = fl(ŝ − q̂)`:
+//!   `|ĉ − c| <= γ_D s + u q + u |ŝ − q̂|`, bounded by `E_c = (D + 1) u ŝ + 2 u (q̂ + |ĉ|)`.
+//!   Touching means `c <= τ = 2u q̂` (the centre distance rounds to `r`; `τ` is exact,
+//!   a power of two times `q̂`); `|ĉ − τ| <= E_c` falls back.
+//! * **Discriminant.** `Δ̂ = fl(fl(ĥ²) − fl(â ĉ))` with `â = fl(Σ wᵢ²)`:
+//!   `|fl(ĥ²) − h²| <= E_h (2|ĥ| + E_h) + u ĥ²` and
+//!   `|fl(â ĉ) − a c| <= |â − a| |c| + â |ĉ − c| + u â |ĉ| <= â ((D + 1) u |ĉ| + E_c)` to
+//!   first order; the subtraction adds `u |Δ̂|`. So
+//!   `E_Δ = (E_h (2|ĥ| + E_h) + â E_c + u (ĥ² + (D + 1) â |ĉ| + |Δ̂|)) (1 + 16u)`, and
+//!   `|Δ̂| <= E_Δ` falls back. Far away (`|u| ≫ r`) `h² ≈ a c` are both of size
+//!   `|u|² |w|²`: a graze by `1e-9` at a distance of `1e6` is inside the bound and is
+//!   decided in double-double, where `Δ` is accurate to about `u² |u|² |w|² ≈ 1e-20 |w|²`
+//!   against the `2e-9 |w|²` at stake.
+//! * **Root.** `t = c / d` with `d = −h + √Δ` (both terms non-negative for a closing pair:
+//!   no cancellation). `|√Δ̂ − √Δ| <= E_Δ / √Δ̂`, so with `σ̂ = fl(√Δ̂)`,
+//!   `d̂ = fl(σ̂ − ĥ)`, `t̂ = fl(ĉ / d̂)`:
+//!   `|t̂ − t| / t <= E_c / ĉ + (E_h + E_Δ / σ̂) / d̂ + 3u + O(u²)`. The root is accepted
+//!   when the first two terms are within the budget `β`, checked without a division as
+//!   `E_c d̂ σ̂ + ĉ (E_h σ̂ + E_Δ) <= β ĉ d̂ σ̂`.
+//! * **Sharpened** `h` and `c` (Dot2 in double-double, rounded once): within
+//!   `u |x| + γ_n² Σ|terms|` of exact (`n = D`, `D + 1`); `Δ̂` and `E_Δ` are recomputed
+//!   from them with the formula above. Near touching `E_c / ĉ` dominates the plain bound;
+//!   for a closing pair near touching `Δ ≈ h²` and `E_h` dominates `E_Δ`: both go.
+//! * **Exact discriminant**: `a` by Dot2 as well and `Δ = h² − a c` from the three
+//!   double-doubles, rounded once; the root is then within about `6u`.
+//!
+//! The bound on the plain root is a worst case, proportional to the conditioning of the
+//! root: a nearly grazing hit (`σ ≪ d`) needs `Δ` to more digits than plain arithmetic
+//! proves however the coefficients are rounded.
+
+use carom_math::{Real, Vector};
+
+use super::Quadratic;
+use super::exact::{DoubleDouble, two_product, two_square};
+
+/// The outcome of a linear sphere-gap query from time 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum LinearContact<T> {
+    /// No contact: receding, missing, tangent, or beyond the horizon.
+    Clear,
+    /// Touching or overlapping at time 0 and closing.
+    Immediate,
+    /// First contact at this time (`> 0`).
+    At(T),
+    /// An intermediate value overflowed.
+    Overflow,
+}
+
+/// `true` if two balls (centres `c₁`, `c₂`, velocities `v₁`, `v₂`, radii `r₁`, `r₂`,
+/// time running in the direction of `sign = ±1`) certainly recede or certainly miss:
+/// the cheap test callers make inline, in the input precision, before anything else
+/// (module docs, "Quick test").
+#[inline]
+pub(crate) fn recedes_or_misses<T: Real, const D: usize>(
+    (c1, c2): (&Vector<T, D>, &Vector<T, D>),
+    (v1, v2): (&Vector<T, D>, &Vector<T, D>),
+    (r1, r2): (T, T),
+    sign: T,
+) -> bool {
+    let unit = unit::<T>();
+    let (u0, w0) = (c2[0] - c1[0], v2[0] - v1[0]);
+    let mut h = u0 * w0;
+    let mut magnitude = h.abs();
+    let (mut a, mut s) = (w0 * w0, u0 * u0);
+    for i in 1..D {
+        let (u, w) = (c2[i] - c1[i], v2[i] - v1[i]);
+        let p = u * w;
+        h += p;
+        magnitude += p.abs();
+        a += w * w;
+        s += u * u;
+    }
+    // The plain sign first: this branch goes either way about half of the time, and it
+    // resolves as soon as `h` is known; its proof, almost always true, comes second.
+    let h = h * sign;
+    if h > T::zero() && h > magnitude * (T::from_count(D + 3) * unit) + T::MIN_POSITIVE {
+        return true;
+    }
+    let r = r1 + r2;
+    let q = r * r;
+    let disc = h * h - a * (s - q);
+    disc < -(a * (s + q) * (T::lit(32.0) * unit) + T::MIN_POSITIVE)
+}
+
+/// The unit roundoff `u = ε/2`.
+#[inline]
+fn unit<T: Real>() -> T {
+    T::EPSILON * T::lit(0.5)
+}
+
+/// A computed value and a bound on its error.
+#[derive(Clone, Copy, Debug)]
+struct Bounded<T> {
+    value: T,
+    err: T,
+}
+
+impl<T: Real> Bounded<T> {
+    /// `true` if the error bound proves the value within `budget` (relative).
+    #[inline]
+    fn within(self, budget: T) -> bool {
+        self.err <= budget * self.value.abs()
+    }
+}
+
+/// The coefficients with their bounds, and the magnitudes the sharpened bounds need.
+#[derive(Clone, Copy, Debug)]
+struct Coefficients<T> {
+    h: Bounded<T>,
+    a: T,
+    c: Bounded<T>,
+    disc: Bounded<T>,
+    /// `fl(Σ|uᵢwᵢ|)`.
+    rate_magnitude: T,
+    /// `ŝ + q̂`.
+    gap_magnitude: T,
+    /// `τ`: the largest `c` that counts as touching.
+    touch: T,
+}
+
+/// `P(t) = |u + w t|² − r²` for linear relative motion.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LinearSphere<T: Real, const D: usize> {
+    u: Vector<T, D>,
+    w: Vector<T, D>,
+    r: T,
+}
+
+impl<T: Real, const D: usize> LinearSphere<T, D> {
+    /// The gap of the offset `u + w t` to a sphere of radius `r`.
+    #[inline]
+    pub(crate) fn new(u: Vector<T, D>, w: Vector<T, D>, r: T) -> Self {
+        Self { u, w, r }
+    }
+
+    /// The offset `u + w s`.
+    #[inline]
+    pub(crate) fn offset(&self, s: T) -> Vector<T, D> {
+        self.u + self.w * s
+    }
+
+    /// The relative velocity `w`.
+    #[inline]
+    pub(crate) fn velocity(&self) -> &Vector<T, D> {
+        &self.w
+    }
+
+    /// The radius `r`.
+    #[inline]
+    pub(crate) fn radius(&self) -> T {
+        self.r
+    }
+
+    /// The plain coefficients and their bounds (module docs).
+    #[inline]
+    fn plain(&self) -> Coefficients<T> {
+        let unit = unit::<T>();
+        let (u, w) = (&self.u, &self.w);
+        let mut h = u[0] * w[0];
+        let mut rate_magnitude = h.abs();
+        let (mut a, mut s) = (w[0] * w[0], u[0] * u[0]);
+        for i in 1..D {
+            let p = u[i] * w[i];
+            h += p;
+            rate_magnitude += p.abs();
+            a += w[i] * w[i];
+            s += u[i] * u[i];
+        }
+        let q = self.r * self.r;
+        let c = s - q;
+        let h = Bounded {
+            value: h,
+            err: rate_magnitude * (T::from_count(D + 1) * unit) + T::MIN_POSITIVE,
+        };
+        let c = Bounded {
+            value: c,
+            err: s * (T::from_count(D + 1) * unit)
+                + (q + c.abs()) * (unit + unit)
+                + T::MIN_POSITIVE,
+        };
+        Coefficients {
+            h,
+            a,
+            c,
+            disc: bounded_discriminant::<T, D>(h, a, c),
+            rate_magnitude,
+            gap_magnitude: s + q,
+            touch: q * (unit + unit),
+        }
+    }
+
+    /// The first contact from time 0 up to `hi` (`+∞` allowed), cheapest case first
+    /// (module docs). `budget` is the relative error allowed for a root computed without
+    /// the double-double discriminant.
+    #[inline]
+    pub(crate) fn first_contact(&self, hi: T, budget: T) -> LinearContact<T> {
+        let p = self.plain();
+        let (h, c, disc) = (p.h, p.c, p.disc);
+        if h.value > h.err {
+            return LinearContact::Clear; // receding
+        }
+        if !disc.err.finite() {
+            return LinearContact::Overflow;
+        }
+        if disc.value < -disc.err {
+            // A certain miss: `Δ < 0` also implies `c > 0` (apart), whatever the rate.
+            return LinearContact::Clear;
+        }
+        if h.value < -h.err {
+            if c.value <= p.touch - c.err {
+                return LinearContact::Immediate; // touching or overlapping, and closing
+            }
+            if c.value > p.touch + c.err && disc.value > disc.err {
+                // A certain hit: the plain root if the bound proves it ...
+                match accurate_root(h, c, disc, budget) {
+                    Ok(t) => return contact_before(t, hi),
+                    // ... or the root certainly beyond the horizon ...
+                    Err(t_min) if hi.finite() && t_min() > hi => return LinearContact::Clear,
+                    Err(_) => {}
+                }
+            }
+        }
+        // ... otherwise sharpen (also when a sign is not proven).
+        self.sharpened_contact(&p, hi, budget)
+    }
+
+    /// [`first_contact`](Self::first_contact) with `h` and `c` in double-double, and then
+    /// `Δ` if needed; out of line.
+    #[inline(never)]
+    fn sharpened_contact(&self, plain: &Coefficients<T>, hi: T, budget: T) -> LinearContact<T> {
+        let (dd_h, dd_c, sharp) = self.sharpen(plain);
+        if sharp.h.value >= T::zero() {
+            return LinearContact::Clear;
+        }
+        if sharp.c.value <= sharp.touch {
+            return LinearContact::Immediate;
+        }
+        let disc = sharp.disc;
+        if disc.value < -disc.err {
+            return LinearContact::Clear;
+        }
+        if disc.value > disc.err
+            && let Ok(t) = accurate_root(sharp.h, sharp.c, disc, budget)
+        {
+            return contact_before(t, hi);
+        }
+        let disc = self.exact_discriminant(dd_h, dd_c);
+        if disc <= T::zero() {
+            LinearContact::Clear
+        } else {
+            contact_before(sharp.c.value / (disc.sqrt() - sharp.h.value), hi)
+        }
+    }
+
+    /// `h` and `c` by Dot2, and `Δ̂`, `E_Δ` recomputed from them (module docs). Called
+    /// only once the plain coefficients are finite, so no split overflows.
+    fn sharpen(
+        &self,
+        plain: &Coefficients<T>,
+    ) -> (DoubleDouble<T>, DoubleDouble<T>, Coefficients<T>) {
+        let unit = unit::<T>();
+        let (u, w) = (&self.u, &self.w);
+        let mut dd_h = DoubleDouble::from_product(two_product(u[0], w[0]));
+        let (q, q_err) = two_square(self.r);
+        let mut dd_c = DoubleDouble::from_product((-q, -q_err));
+        for i in 0..D {
+            if i > 0 {
+                dd_h = dd_h.add_product(two_product(u[i], w[i]));
+            }
+            dd_c = dd_c.add_product(two_square(u[i]));
+        }
+        let (dd_h, dd_c) = (dd_h.finish(), dd_c.finish());
+        // Dot2: |res − x| <= u |x| + γ_n² Σ|terms|, so `(u |res| + (n + 1)² u² M)(1 + 4u)`.
+        let dot2 = |res: T, n: usize, magnitude: T| {
+            let gamma = T::from_count(n + 1) * unit;
+            (res.abs() * unit + magnitude * gamma * gamma) * (T::one() + T::lit(4.0) * unit)
+                + T::MIN_POSITIVE
+        };
+        let h = Bounded {
+            value: dd_h.value(),
+            err: dot2(dd_h.value(), D, plain.rate_magnitude),
+        };
+        let c = Bounded {
+            value: dd_c.value(),
+            err: dot2(dd_c.value(), D + 1, plain.gap_magnitude),
+        };
+        let sharp = Coefficients {
+            h,
+            c,
+            disc: bounded_discriminant::<T, D>(h, plain.a, c),
+            ..*plain
+        };
+        (dd_h, dd_c, sharp)
+    }
+
+    /// `Δ = h² − a c` from double-double `h`, `c` and `a = Σ wᵢ²` by Dot2, rounded once.
+    fn exact_discriminant(&self, h: DoubleDouble<T>, c: DoubleDouble<T>) -> T {
+        let w = &self.w;
+        let mut a = DoubleDouble::from_product(two_square(w[0]));
+        for x in w.iter().skip(1) {
+            a = a.add_product(two_square(*x));
+        }
+        h.square_minus_product(a.finish(), c)
+    }
+
+    /// `a t² + 2 h t + c` with every coefficient within `budget` (relative) of exact:
+    /// plain where the bounds prove it, sharpened otherwise (the double-double `Δ` is
+    /// within about `u`); `None` on overflow.
+    pub(crate) fn quadratic(&self, budget: T) -> Option<Quadratic<T>> {
+        let p = self.plain();
+        if !p.disc.err.finite() {
+            return None;
+        }
+        if p.h.within(budget) && p.c.within(budget) && p.disc.within(budget) {
+            return Some(Quadratic::with_discriminant(
+                p.a,
+                p.h.value,
+                p.c.value,
+                p.disc.value,
+            ));
+        }
+        let (dd_h, dd_c, sharp) = self.sharpen(&p);
+        let disc = if sharp.disc.within(budget) {
+            sharp.disc.value
+        } else {
+            self.exact_discriminant(dd_h, dd_c)
+        };
+        Some(Quadratic::with_discriminant(
+            p.a,
+            sharp.h.value,
+            sharp.c.value,
+            disc,
+        ))
+    }
+}
+
+/// `Δ̂ = fl(ĥ² − â ĉ)` and its bound `E_Δ` (module docs).
+#[inline]
+fn bounded_discriminant<T: Real, const D: usize>(h: Bounded<T>, a: T, c: Bounded<T>) -> Bounded<T> {
+    let unit = unit::<T>();
+    let hh = h.value * h.value;
+    let disc = hh - a * c.value;
+    let err = ((h.err * (h.value.abs() * T::lit(2.0) + h.err) + a * c.err)
+        + (hh + a * c.value.abs() * T::from_count(D + 1) + disc.abs()) * unit)
+        * (T::one() + T::lit(16.0) * unit)
+        + T::MIN_POSITIVE;
+    Bounded { value: disc, err }
+}
+
+/// The root `c / (−h + √Δ)` of a certain hit (`h < 0`, `c > 0`, `Δ > 0` proven) if the
+/// bounds prove it within `budget` (plus `3u`) of exact (module docs); otherwise a lower
+/// bound on it, computed on demand.
+#[inline]
+fn accurate_root<T: Real>(
+    h: Bounded<T>,
+    c: Bounded<T>,
+    disc: Bounded<T>,
+    budget: T,
+) -> Result<T, impl Fn() -> T> {
+    let sigma = disc.value.sqrt();
+    let d = sigma - h.value;
+    let scale = c.value * d * sigma;
+    let bound = c.err * d * sigma + c.value * (h.err * sigma + disc.err);
+    let t = c.value / d;
+    if bound <= budget * scale {
+        Ok(t)
+    } else {
+        // t >= t̂ (1 − ρ) with ρ = bound / scale + 3u; twice that covers second order.
+        Err(move || {
+            let rho = bound / scale + T::lit(3.0) * unit::<T>();
+            t * (T::one() - rho - rho)
+        })
+    }
+}
+
+/// A contact at `t` if it is within the horizon.
+#[inline]
+fn contact_before<T: Real>(t: T, hi: T) -> LinearContact<T> {
+    if t <= hi {
+        LinearContact::At(t)
+    } else {
+        LinearContact::Clear
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The bounds and decisions against exact integer arithmetic: integer-valued inputs
+    //! (below `2^30`) make every coefficient an exact `i128` (`Δ` below `2^124`), while
+    //! their products exceed 53 bits, so the plain evaluation does round.
+
+    use super::*;
+    use nalgebra::Vector3;
+    use proptest::prelude::*;
+
+    const U: f64 = f64::EPSILON / 2.0;
+
+    /// The exact coefficients of `|u + w t|² − r²` for integer inputs.
+    #[derive(Debug)]
+    struct Exact {
+        h: i128,
+        a: i128,
+        c: i128,
+        disc: i128,
+    }
+
+    fn exact(u: [i64; 3], w: [i64; 3], r: i64) -> Exact {
+        let dot = |x: [i64; 3], y: [i64; 3]| -> i128 {
+            x.iter()
+                .zip(y)
+                .map(|(&a, b)| i128::from(a) * i128::from(b))
+                .sum()
+        };
+        let (h, a) = (dot(u, w), dot(w, w));
+        let c = dot(u, u) - i128::from(r) * i128::from(r);
+        Exact {
+            h,
+            a,
+            c,
+            disc: h * h - a * c,
+        }
+    }
+
+    fn sphere(u: [i64; 3], w: [i64; 3], r: i64) -> LinearSphere<f64, 3> {
+        let f = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
+        LinearSphere::new(f(u), f(w), r as f64)
+    }
+
+    /// `|computed − exact| <= bound`; every computed value is an integer here (sums and
+    /// products of integers round to integers).
+    fn within(computed: f64, exact: i128, bound: f64) -> bool {
+        assert_eq!(computed.fract(), 0.0);
+        ((computed as i128) - exact).unsigned_abs() as f64 <= bound
+    }
+
+    /// The reference answer: status from the exact signs, root in f64 from the exact
+    /// integers (within about `4u`).
+    fn reference(e: &Exact, r: i64) -> LinearContact<f64> {
+        let touch = (r as f64 * r as f64) * (2.0 * U);
+        if e.h >= 0 {
+            LinearContact::Clear
+        } else if (e.c as f64) <= touch {
+            LinearContact::Immediate
+        } else if e.disc <= 0 {
+            LinearContact::Clear
+        } else {
+            LinearContact::At(e.c as f64 / ((e.disc as f64).sqrt() - e.h as f64))
+        }
+    }
+
+    /// `first_contact` agrees with the reference, the root within `16u` (the guarantee)
+    /// plus the reference's own `4u`.
+    fn agrees(u: [i64; 3], w: [i64; 3], r: i64, budget: f64) -> Result<(), TestCaseError> {
+        let e = exact(u, w, r);
+        let got = sphere(u, w, r).first_contact(f64::INFINITY, budget);
+        match (got, reference(&e, r)) {
+            (LinearContact::At(t), LinearContact::At(t_ref)) => {
+                prop_assert!(
+                    (t - t_ref).abs() <= 20.0 * U * t_ref,
+                    "{t} vs {t_ref} {e:?}"
+                );
+            }
+            (got, want) => prop_assert_eq!(got, want, "{:?}", e),
+        }
+        Ok(())
+    }
+
+    fn int3() -> impl Strategy<Value = [i64; 3]> {
+        prop::array::uniform3(-(1i64 << 29)..(1i64 << 29))
+    }
+
+    /// `u` and `w` with `u·w < 0` (closing), from any pair.
+    fn closing(u: [i64; 3], w: [i64; 3]) -> ([i64; 3], [i64; 3]) {
+        if exact(u, w, 0).h > 0 {
+            (u, w.map(|x| -x))
+        } else {
+            (u, w)
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// The plain and sharpened bounds of the module docs hold.
+        #[test]
+        fn bounds_hold(u in int3(), w in int3(), r in 1i64..(1 << 29)) {
+            let e = exact(u, w, r);
+            let s = sphere(u, w, r);
+            let p = s.plain();
+            prop_assert!(within(p.h.value, e.h, p.h.err), "h {p:?} {e:?}");
+            prop_assert!(within(p.c.value, e.c, p.c.err), "c {p:?} {e:?}");
+            prop_assert!(within(p.disc.value, e.disc, p.disc.err), "disc {p:?} {e:?}");
+            let (dd_h, dd_c, sharp) = s.sharpen(&p);
+            prop_assert!(within(sharp.h.value, e.h, sharp.h.err));
+            prop_assert!(within(sharp.c.value, e.c, sharp.c.err));
+            prop_assert!(within(sharp.disc.value, e.disc, sharp.disc.err));
+            // The double-double discriminant: one rounding plus u² of the terms.
+            let disc = s.exact_discriminant(dd_h, dd_c);
+            let terms = (e.h * e.h) as f64 + (e.a as f64) * (e.c.abs() as f64);
+            prop_assert!(within(disc, e.disc, U * (e.disc.abs() as f64) * 1.01 + 64.0 * U * U * terms));
+        }
+
+        /// The quick test only ever claims a certain recession or miss, also in f32 where
+        /// the differences of the inputs round.
+        #[test]
+        fn quick_test_is_never_wrong(
+            c1 in int3(), c2 in int3(), v1 in int3(), v2 in int3(),
+            r1 in 1i64..(1 << 28), r2 in 1i64..(1 << 28), backward in any::<bool>(),
+        ) {
+            let sign = if backward { -1 } else { 1 };
+            let d = |x: [i64; 3], y: [i64; 3]| [0, 1, 2].map(|i| y[i] - x[i]);
+            // f32 inputs: round each to f32 and take the exact integer it became.
+            let f = |x: [i64; 3]| x.map(|v| v as f32 as i64);
+            let (c1f, c2f, v1f, v2f) = (f(c1), f(c2), f(v1), f(v2));
+            let (r1f, r2f) = (r1 as f32 as i64, r2 as f32 as i64);
+            let e = exact(d(c1f, c2f), d(v1f, v2f).map(|x| x * sign), r1f + r2f);
+            let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
+            if recedes_or_misses(
+                (&v3(c1f), &v3(c2f)),
+                (&v3(v1f), &v3(v2f)),
+                (r1f as f32, r2f as f32),
+                sign as f32,
+            ) {
+                prop_assert!(e.h > 0 || e.disc < 0, "{e:?}");
+            }
+            let e = exact(d(c1, c2), d(v1, v2).map(|x| x * sign), r1 + r2);
+            let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
+            if recedes_or_misses((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1 as f64, r2 as f64), sign as f64) {
+                prop_assert!(e.h > 0 || e.disc < 0, "{e:?}");
+            }
+        }
+
+        /// The quick test near its boundaries: grazes far away and tangential motions
+        /// (as below), placed at random offsets so that the differences of the inputs
+        /// round, in f32 and f64.
+        #[test]
+        fn quick_test_is_never_wrong_near_its_boundaries(
+            w in prop::array::uniform3(-(1i64 << 20)..(1 << 20)), s in -(1i64 << 8)..0,
+            p in prop::array::uniform3(-(1i64 << 12)..(1 << 12)), delta in -8i64..=8,
+            k in 1i64..16, z in -8i64..=8, tangential in any::<bool>(),
+            offset in int3(), drift in int3(),
+        ) {
+            let (u, w, r) = if tangential {
+                let (a, b) = (w[0] << 8, w[1] << 8);
+                let r = ((a * a + b * b + 1) as f64).sqrt() as i64 + delta.signum();
+                ([a, b, 1], [-k * b, k * a, z], r.max(2))
+            } else {
+                let u = [0, 1, 2].map(|i| s * w[i] + p[i]);
+                let e = exact(u, w, 0);
+                prop_assume!(e.a > 0);
+                let miss = ((-e.disc) as f64 / e.a as f64).sqrt();
+                (u, w, (miss.round() as i64 + delta).max(2))
+            };
+            let add = |x: [i64; 3], y: [i64; 3]| [0, 1, 2].map(|i| x[i] + y[i]);
+            let (c1, c2, v1, v2) = (offset, add(offset, u), drift, add(drift, w));
+            for sign in [1, -1] {
+                // f32: every input rounds to f32; the reference takes the rounded values.
+                let f = |x: [i64; 3]| x.map(|v| v as f32 as i64);
+                let d = |x: [i64; 3], y: [i64; 3]| [0, 1, 2].map(|i| y[i] - x[i]);
+                let (r1, r2) = ((r / 2) as f32 as i64, (r - r / 2) as f32 as i64);
+                let e = exact(d(f(c1), f(c2)), d(f(v1), f(v2)).map(|x| x * sign), r1 + r2);
+                let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
+                if recedes_or_misses(
+                    (&v3(c1), &v3(c2)),
+                    (&v3(v1), &v3(v2)),
+                    (r1 as f32, r2 as f32),
+                    sign as f32,
+                ) {
+                    prop_assert!(e.h > 0 || e.disc < 0, "f32 {e:?}");
+                }
+                let e = exact(u, w.map(|x| x * sign), r);
+                let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
+                let (r1, r2) = ((r / 2) as f64, (r - r / 2) as f64);
+                if recedes_or_misses((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1, r2), sign as f64) {
+                    prop_assert!(e.h > 0 || e.disc < 0, "f64 {e:?}");
+                }
+            }
+        }
+
+        /// Random pairs: mostly decided and solved by the plain values.
+        #[test]
+        fn random_pairs_match_exact_arithmetic(u in int3(), w in int3(), r in 1i64..(1 << 29)) {
+            agrees(u, w, r, 12.0 * U)?;
+        }
+
+        /// A graze far away: `u = s w + p` (`s` up to `−2⁸`, `p` small), so the miss
+        /// distance is about `|p|` while `|u| ≈ |s| |w|` is up to `2²⁴` times larger; the
+        /// radius is the miss distance rounded, moved by `δ`. `Δ = |w|² r² − |u ∧ w|²`
+        /// is then within a few `|w|² r` of zero while `h² ≈ a c ≈ |u|² |w|²`: inside the
+        /// plain bound for small `δ` (decided in double-double), outside for large ones.
+        #[test]
+        fn grazes_far_away_match_exact_arithmetic(
+            w in prop::array::uniform3(-(1i64 << 20)..(1 << 20)), s in -(1i64 << 8)..0,
+            p in prop::array::uniform3(-(1i64 << 12)..(1 << 12)), delta in -8i64..=8,
+        ) {
+            let u = [0, 1, 2].map(|i| s * w[i] + p[i]);
+            let e = exact(u, w, 0);
+            prop_assume!(e.h < 0 && e.a > 0);
+            // With r = 0, Δ = h² − a |u|² = −|u ∧ w|²: the miss distance is √(−Δ/a).
+            let miss = ((-e.disc) as f64 / e.a as f64).sqrt();
+            let r = (miss.round() as i64 + delta).max(1);
+            agrees(u, w, r, 12.0 * U)?;
+            // Forcing the double-double root changes nothing but accuracy.
+            agrees(u, w, r, 0.0)?;
+        }
+
+        /// Nearly touching: `u = (r, x, y)` (permuted, signs flipped) with `x² + y²` up to
+        /// 1024, so `c` is between 0 and 1024 against `r² ≈ 2⁵⁸`: touching (`c <= 2u r²`,
+        /// about 64), or apart by less than the plain bound.
+        #[test]
+        fn near_touching_matches_exact_arithmetic(
+            r in (1i64 << 28)..(1 << 29), x in 0i64..32, y in 0i64..32, w in int3(),
+            perm in 0usize..3, signs in prop::array::uniform3(any::<bool>()), inside in any::<bool>(),
+        ) {
+            let mut u = [r, x, y];
+            u.rotate_left(perm);
+            for (v, s) in u.iter_mut().zip(signs) {
+                if s { *v = -*v; }
+            }
+            let (u, w) = closing(u, w);
+            let r = if inside { r + 1 } else { r };
+            agrees(u, w, r, 12.0 * U)?;
+        }
+
+        /// Tangential motion: `u = (a, b, 1)`, `w = (−k b, k a, z)`, so `u·w = z`, a few
+        /// units against `Σ|uᵢwᵢ| ≈ 2⁵⁹`: the sign of the rate is beyond the plain bound
+        /// and decides touching pairs (closing or resting).
+        #[test]
+        fn tangential_motion_matches_exact_arithmetic(
+            a in (1i64 << 25)..(1 << 29), b in (1i64 << 25)..(1 << 29), k in 1i64..16,
+            z in -8i64..=8, r_offset in -2i64..3, flip in any::<bool>(),
+        ) {
+            let a = if flip { -a } else { a };
+            let (u, w) = ([a, b, 1], [-k * b, k * a, z]);
+            let distance = ((a * a + b * b + 1) as f64).sqrt() as i64;
+            agrees(u, w, distance + r_offset, 12.0 * U)?;
+        }
+    }
+}
