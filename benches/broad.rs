@@ -1,0 +1,446 @@
+//! Broad-phase benchmarks: carom's sweep-and-prune, k-d tree and grids against parry's
+//! BVH, on the shared scenes of `carom_broad::scenes`.
+//!
+//! One measured frame is `update` + `pairs` (or `par_update` + `par_pairs` on a pool of
+//! 2 threads):
+//! everything a stepped engine pays per step. One-shot frames alternate between two
+//! unrelated scenes; coherent frames alternate between a scene and the same scene with
+//! every ball moved by 1 % of its radius. Throughput is in balls, so criterion's
+//! "elements/s" is the inverse of the ns per ball.
+//!
+//! * `cargo bench --bench broad`: criterion, N = 1e3 … 1e5, uniform at packing fraction
+//!   0.1 and clustered, 2D and 3D, one-shot and coherent, 1 and 2 threads (≈ 10 min).
+//! * `CAROM_BENCH_FULL=1`: adds fraction 0.5 and N = 1e6 (long).
+//! * `CAROM_BENCH_SIZES=1000,1000000`: these ball counts instead.
+//! * `CAROM_BENCH_FILTER=3D`: table mode runs only the cases whose label
+//!   ("3D uniform0.1 1000000 coherent") contains the text.
+//! * `CAROM_BENCH_TABLE=1`: instead of criterion, prints the markdown table of
+//!   docs/broad-phase.md (median of repeated frames: ns per ball, pairs per second,
+//!   2-thread speedup) and the 10,000-random-boxes figure. Single-thread figures are
+//!   time on CPU (Linux), so that other processes on a shared machine inflate them
+//!   less; 2-thread figures are wall-clock time.
+//!
+//! parry's BVH (f32, glam) is built with `Bvh::from_leaves(Binned)` one-shot and
+//! updated with `insert_or_update_partially` + `refit` when coherent, then traversed
+//! against itself (`traverse_bvtt_single_tree`); it reports box pairs, unsorted, while
+//! carom's rows include the exact ball test and the sorted output.
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use carom::broad::scenes::Scene;
+use carom::broad::{
+    KdTree, Pair, ParallelBroadPhase, SortPolicy, SweepAndPrune, UniformGrid, Volumes,
+};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+
+/// A scene distribution of the benchmark matrix.
+#[derive(Clone, Copy, Debug)]
+enum Distribution {
+    /// Uniform at a packing fraction.
+    Uniform(f64),
+    /// 16 clumps, packing fraction 0.1 over the whole domain.
+    Clustered,
+}
+
+impl Distribution {
+    fn name(self) -> String {
+        match self {
+            Self::Uniform(f) => format!("uniform{f}"),
+            Self::Clustered => "clustered".to_owned(),
+        }
+    }
+
+    fn scene<const D: usize>(self, n: usize, seed: u64) -> Scene<f64, D> {
+        match self {
+            Self::Uniform(f) => Scene::uniform(n, 0.5, f, 0.0, seed),
+            Self::Clustered => Scene::clustered(n, 0.5, 0.1, 16, seed),
+        }
+    }
+}
+
+/// The two frames a benchmark alternates between.
+struct Frames<const D: usize> {
+    frames: [Scene<f64, D>; 2],
+}
+
+impl<const D: usize> Frames<D> {
+    fn new(dist: Distribution, n: usize, coherent: bool) -> Self {
+        let a = dist.scene::<D>(n, 1);
+        let b = if coherent {
+            let mut b = a.clone();
+            b.step(0.01);
+            b
+        } else {
+            dist.scene::<D>(n, 2)
+        };
+        Self { frames: [a, b] }
+    }
+}
+
+/// The broad phases measured, by name.
+const PHASES: [&str; 5] = ["sap", "kd", "grid", "hashed", "brute"];
+
+fn make_phase<const D: usize>(name: &str, coherent: bool) -> Box<dyn ParallelBroadPhase<f64, D>> {
+    match name {
+        "sap" if coherent => Box::new(SweepAndPrune::new()),
+        "sap" => Box::new(SweepAndPrune::with_policy(SortPolicy::Radix)),
+        "kd" => Box::new(KdTree::new()),
+        "grid" => Box::new(UniformGrid::dense()),
+        "hashed" => Box::new(UniformGrid::hashed()),
+        _ => Box::new(carom::broad::BruteForce::new()),
+    }
+}
+
+/// One frame of a carom broad phase; returns the pair count.
+fn frame<const D: usize>(
+    phase: &mut dyn ParallelBroadPhase<f64, D>,
+    volumes: Volumes<'_, f64, D>,
+    pool: Option<&rayon::ThreadPool>,
+    out: &mut Vec<Pair>,
+) -> usize {
+    match pool {
+        None => {
+            phase.update(volumes);
+            phase.pairs(out);
+        }
+        Some(pool) => pool.install(|| {
+            phase.par_update(volumes);
+            phase.par_pairs(out);
+        }),
+    }
+    out.len()
+}
+
+/// parry's BVH as a peer, in 2D and 3D.
+trait Peer<const D: usize> {
+    /// One frame; returns the pair count.
+    fn frame(&mut self, scene: &Scene<f64, D>, coherent: bool) -> usize;
+}
+
+macro_rules! parry_peer {
+    ($name:ident, $parry:ident, $d:literal) => {
+        #[derive(Default)]
+        struct $name {
+            bvh: Option<$parry::partitioning::Bvh>,
+            workspace: $parry::partitioning::BvhWorkspace,
+            leaves: Vec<$parry::bounding_volume::Aabb>,
+            pairs: Vec<(u32, u32)>,
+        }
+
+        impl Peer<$d> for $name {
+            fn frame(&mut self, scene: &Scene<f64, $d>, coherent: bool) -> usize {
+                use $parry::bounding_volume::Aabb;
+                use $parry::math::Vector;
+                use $parry::partitioning::{Bvh, BvhBuildStrategy};
+                self.leaves.clear();
+                for (c, &r) in scene.centers.iter().zip(&scene.radii) {
+                    let lo: [f32; $d] = core::array::from_fn(|k| (c[k] - r) as f32);
+                    let hi: [f32; $d] = core::array::from_fn(|k| (c[k] + r) as f32);
+                    self.leaves
+                        .push(Aabb::new(Vector::from_array(lo), Vector::from_array(hi)));
+                }
+                match (&mut self.bvh, coherent) {
+                    (Some(bvh), true) => {
+                        for (i, aabb) in self.leaves.iter().enumerate() {
+                            bvh.insert_or_update_partially(*aabb, i as u32, 0.0);
+                        }
+                        bvh.refit(&mut self.workspace);
+                    }
+                    _ => self.bvh = Some(Bvh::from_leaves(BvhBuildStrategy::Binned, &self.leaves)),
+                }
+                self.pairs.clear();
+                let pairs = &mut self.pairs;
+                if let Some(bvh) = &self.bvh {
+                    bvh.traverse_bvtt_single_tree::<false>(&mut self.workspace, &mut |a, b| {
+                        pairs.push((a, b))
+                    });
+                }
+                self.pairs.len()
+            }
+        }
+    };
+}
+
+parry_peer!(Parry2, parry2d, 2);
+parry_peer!(Parry3, parry3d, 3);
+
+fn full() -> bool {
+    std::env::var_os("CAROM_BENCH_FULL").is_some()
+}
+
+fn sizes() -> Vec<usize> {
+    if let Ok(list) = std::env::var("CAROM_BENCH_SIZES") {
+        return list
+            .split(',')
+            .filter_map(|x| x.trim().parse().ok())
+            .collect();
+    }
+    if full() {
+        vec![1_000, 10_000, 100_000, 1_000_000]
+    } else {
+        vec![1_000, 10_000, 100_000]
+    }
+}
+
+fn distributions() -> Vec<Distribution> {
+    if full() {
+        vec![
+            Distribution::Uniform(0.1),
+            Distribution::Uniform(0.5),
+            Distribution::Clustered,
+        ]
+    } else {
+        vec![Distribution::Uniform(0.1), Distribution::Clustered]
+    }
+}
+
+/// Brute force only where it finishes in reasonable time; `CAROM_BENCH_PHASES=sap,grid`
+/// restricts the phases.
+fn runs(name: &str, n: usize) -> bool {
+    let chosen =
+        std::env::var("CAROM_BENCH_PHASES").map_or(true, |list| list.split(',').any(|p| p == name));
+    chosen && (name != "brute" || n <= 1_000)
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool")
+}
+
+// ---------------------------------------------------------------------------------
+// criterion
+
+fn bench_dim<const D: usize>(c: &mut Criterion, peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
+    let two = pool(2);
+    for dist in distributions() {
+        for &n in &sizes() {
+            for coherent in [false, true] {
+                let mode = if coherent { "coherent" } else { "oneshot" };
+                let frames = Frames::<D>::new(dist, n, coherent);
+                let mut group = c.benchmark_group(format!("broad/{D}d/{}/{mode}", dist.name()));
+                group.throughput(Throughput::Elements(n as u64));
+                group.sample_size(10);
+                group.warm_up_time(Duration::from_millis(300));
+                group.measurement_time(Duration::from_millis(if n >= 1_000_000 {
+                    8000
+                } else {
+                    1200
+                }));
+                let mut out = Vec::new();
+                for name in PHASES.into_iter().filter(|p| runs(p, n)) {
+                    for threads in [1, 2] {
+                        if threads == 2 && name == "brute" {
+                            continue;
+                        }
+                        let mut phase = make_phase::<D>(name, coherent);
+                        let p = (threads == 2).then_some(&two);
+                        let mut k = 0usize;
+                        group.bench_function(
+                            BenchmarkId::new(format!("{name}/{threads}t"), n),
+                            |b| {
+                                b.iter(|| {
+                                    k += 1;
+                                    black_box(frame(
+                                        phase.as_mut(),
+                                        frames.frames[k % 2].balls(),
+                                        p,
+                                        &mut out,
+                                    ))
+                                });
+                            },
+                        );
+                    }
+                }
+                let mut parry = peer();
+                let mut k = 0usize;
+                group.bench_function(BenchmarkId::new("parry-bvh/1t", n), |b| {
+                    b.iter(|| {
+                        k += 1;
+                        black_box(parry.frame(&frames.frames[k % 2], coherent))
+                    });
+                });
+                group.finish();
+            }
+        }
+    }
+}
+
+fn bench_random_boxes(c: &mut Criterion) {
+    let a = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 1);
+    let b = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 2);
+    let mut group = c.benchmark_group("broad/terdiman-10k-random-boxes");
+    group.throughput(Throughput::Elements(10_000));
+    let mut out = Vec::new();
+    for name in ["sap", "grid", "kd"] {
+        let mut phase = make_phase::<3>(name, false);
+        let mut k = 0usize;
+        group.bench_function(name, |bench| {
+            bench.iter(|| {
+                k += 1;
+                let s = if k.is_multiple_of(2) { &a } else { &b };
+                black_box(frame(phase.as_mut(), s.aabbs(), None, &mut out))
+            });
+        });
+    }
+    group.finish();
+}
+
+fn criterion_benches(c: &mut Criterion) {
+    if std::env::var_os("CAROM_BENCH_TABLE").is_some() {
+        print_table();
+        return;
+    }
+    bench_random_boxes(c);
+    bench_dim::<2>(c, &mut || Box::new(Parry2::default()));
+    bench_dim::<3>(c, &mut || Box::new(Parry3::default()));
+}
+
+// ---------------------------------------------------------------------------------
+// table mode
+
+/// The time this thread has spent on a CPU (Linux: `/proc/thread-self/schedstat`), so
+/// that single-thread figures exclude the time other processes held the cores.
+fn on_cpu() -> Option<Duration> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(Duration::from_nanos(
+        text.split_whitespace().next()?.parse().ok()?,
+    ))
+}
+
+/// The median duration of one call of `f`, over at least 5 samples (~0.5 s in all):
+/// each sample times a batch of calls lasting at least 25 ms, on CPU when `cpu` is set
+/// and the platform reports it (the per-thread clock ticks too coarsely for one short
+/// call), wall-clock otherwise.
+fn median_time(cpu: bool, mut f: impl FnMut(usize)) -> Duration {
+    let clock = || if cpu { on_cpu() } else { None };
+    let t = Instant::now();
+    f(0);
+    f(1);
+    let per_call = t.elapsed() / 2;
+    let batch = (Duration::from_millis(25).as_nanos() / per_call.as_nanos().max(1))
+        .clamp(1, 100_000) as usize;
+    let mut times = Vec::new();
+    let start = Instant::now();
+    let mut k = 0;
+    while times.len() < 5 || (start.elapsed() < Duration::from_millis(500) && times.len() < 100) {
+        let (t, c) = (Instant::now(), clock());
+        for _ in 0..batch {
+            f(k);
+            k += 1;
+        }
+        let total = match (c, clock()) {
+            (Some(a), Some(b)) => b.saturating_sub(a),
+            _ => t.elapsed(),
+        };
+        times.push(total / batch as u32);
+    }
+    times.sort();
+    times[times.len() / 2]
+}
+
+/// Prints one table row: `case` is "dim | scene | N | frames", `one` and `two` the
+/// frame times on 1 and 2 threads.
+fn row(case: &str, n: usize, name: &str, one: Duration, two: Option<Duration>, pairs: usize) {
+    let ns = one.as_secs_f64() * 1e9 / n as f64;
+    let mpairs = pairs as f64 / one.as_secs_f64() / 1e6;
+    let (ns2, speedup) = match two {
+        Some(t) => (
+            format!("{:.1}", t.as_secs_f64() * 1e9 / n as f64),
+            format!("{:.2}", one.as_secs_f64() / t.as_secs_f64()),
+        ),
+        None => ("–".to_owned(), "–".to_owned()),
+    };
+    println!(
+        "| {case} | {name} | {ns:.1} | {ns2} | {speedup} | {mpairs:.1} | {:.2} |",
+        pairs as f64 / n as f64
+    );
+}
+
+fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
+    let two = pool(2);
+    for dist in distributions() {
+        for &n in &sizes() {
+            for coherent in [false, true] {
+                let mode = if coherent { "coherent" } else { "one-shot" };
+                let label = format!("{D}D {} {n} {mode}", dist.name());
+                if !std::env::var("CAROM_BENCH_FILTER").is_ok_and(|f| label.contains(&f))
+                    && std::env::var_os("CAROM_BENCH_FILTER").is_some()
+                {
+                    continue;
+                }
+                let frames = Frames::<D>::new(dist, n, coherent);
+                let mut out = Vec::new();
+                for name in PHASES.into_iter().filter(|p| runs(p, n)) {
+                    let mut phase = make_phase::<D>(name, coherent);
+                    let mut pairs = 0;
+                    let one = median_time(true, |k| {
+                        pairs = frame(phase.as_mut(), frames.frames[k % 2].balls(), None, &mut out);
+                    });
+                    let two_t = (name != "brute").then(|| {
+                        median_time(false, |k| {
+                            frame(
+                                phase.as_mut(),
+                                frames.frames[k % 2].balls(),
+                                Some(&two),
+                                &mut out,
+                            );
+                        })
+                    });
+                    row(
+                        &format!("{D}D | {} | {n} | {mode}", dist.name()),
+                        n,
+                        name,
+                        one,
+                        two_t,
+                        pairs,
+                    );
+                }
+                let mut parry = peer();
+                let mut pairs = 0;
+                let one = median_time(true, |k| {
+                    pairs = parry.frame(&frames.frames[k % 2], coherent);
+                });
+                let case = format!("{D}D | {} | {n} | {mode}", dist.name());
+                row(&case, n, "parry-bvh (f32, box pairs)", one, None, pairs);
+            }
+        }
+    }
+}
+
+fn print_table() {
+    println!(
+        "| dim | scene | N | frames | broad phase | ns/ball 1t | ns/ball 2t | speedup | Mpairs/s 1t | pairs/ball |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let a = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 1);
+    let b = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 2);
+    let mut out = Vec::new();
+    for name in ["sap", "grid", "kd"].into_iter().filter(|p| runs(p, 0)) {
+        let mut phase = make_phase::<3>(name, false);
+        let mut pairs = 0;
+        let one = median_time(true, |k| {
+            let boxes = if k.is_multiple_of(2) {
+                a.aabbs()
+            } else {
+                b.aabbs()
+            };
+            pairs = frame(phase.as_mut(), boxes, None, &mut out);
+        });
+        row(
+            "3D | 10k random boxes (Terdiman) | 10000 | one-shot",
+            10_000,
+            name,
+            one,
+            None,
+            pairs,
+        );
+    }
+    table_dim::<2>(&mut || Box::new(Parry2::default()));
+    table_dim::<3>(&mut || Box::new(Parry3::default()));
+}
+
+criterion_group!(benches, criterion_benches);
+criterion_main!(benches);

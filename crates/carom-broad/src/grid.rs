@@ -1,0 +1,773 @@
+//! Uniform grids: cells the size of the largest regular volume, dense, hashed or
+//! periodic, with a separate path for oversized volumes.
+//!
+//! Each volume is assigned to the cell of its centre. With cells at least as wide as
+//! the largest volume, two overlapping volumes sit in the same or in adjacent cells, so
+//! each cell is tested against itself and against the "forward" half of its neighbours
+//! (4 in 2D, 13 in 3D): every neighbouring cell pair is visited once.
+//!
+//! * **Cell size.** `oversize_ratio × median` (default 2) of the volumes' largest edge
+//!   lengths (the median estimated from at most 1025 strided samples) separates regular volumes from oversized ones; the cell is the largest
+//!   regular edge, grown by `2^-10` relative and `16 ε_T · scale` absolute so that no
+//!   rounding can put two touching volumes two cells apart, even at `1e6` from the
+//!   origin. Volumes are sorted into cells by a counting sort (one pass to count, one to
+//!   place, no per-cell `Vec`).
+//! * **Oversized volumes** stay out of the cells. Each one is tested against the regular
+//!   volumes of the cells its box (grown by half a cell) covers, or against all of them
+//!   when that is fewer; oversized volumes meet each other in a sweep-and-prune (in a
+//!   periodic domain, by brute force). With very mixed sizes that list grows, and
+//!   [`SweepAndPrune`](crate::SweepAndPrune) is the better choice.
+//! * **Layouts.** [`GridLayout::Dense`] spans the bounding box of this frame's centres
+//!   with at most `8N + 64` cells (the cell grows if the scene is sparse);
+//!   [`GridLayout::Hashed`] hashes integer cell coordinates into a table of about `2N`
+//!   buckets, for unbounded or sparse worlds (a bucket can hold several cells, so each
+//!   entry keeps its cell coordinates and only entries of the wanted cell are tested);
+//!   [`GridLayout::Periodic`] tiles a periodic [`Border`] with whole cells and wraps the
+//!   neighbours around (the cell lists of event-driven codes). A periodic box needs at
+//!   least 3 cells per axis; a smaller one puts every volume on the brute-force path.
+//!   In a periodic domain overlaps use the minimum image, which is unique while every
+//!   volume is smaller than a third of the period; pairs are reported once.
+
+use carom_geometry::{Aabb, Border};
+use carom_math::{Real, Vector};
+
+use crate::pairs::{Emitter, PairBuffers};
+use crate::par::{extend_indexed, map_in_place, max_indexed};
+use crate::radix::{entry, entry_id, entry_key, insertion_sort_bounded, radix_sort_by_key};
+use crate::sweep::{SortPolicy, SweepCore};
+use crate::volumes::{Proxy, Store, overlap, sampled_median};
+use crate::{BroadPhase, Pair, Volumes};
+
+/// How a [`UniformGrid`] lays its cells out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GridLayout<T: Real, const D: usize> {
+    /// A dense array over the bounding box of the current centres.
+    Dense,
+    /// A hash table of about `2N` buckets over unbounded integer cell coordinates.
+    Hashed,
+    /// A dense array tiling a periodic domain, with wrap-around neighbours.
+    Periodic(Border<T, D>),
+}
+
+/// Cell coordinates are `i32`: the grid never has more than `2^30` cells per axis.
+type Cell<const D: usize> = [i32; D];
+
+const MAX_CELLS_PER_AXIS: f64 = (1u64 << 30) as f64;
+
+/// The cell geometry of one update.
+#[derive(Clone, Copy, Debug)]
+struct Geometry<const D: usize> {
+    origin: [f64; D],
+    inv_cell: [f64; D],
+    /// Cells per axis (dense and periodic).
+    dims: [i64; D],
+    /// Buckets: cells (dense, periodic) or the hash table size (a power of two).
+    buckets: usize,
+    hashed: bool,
+    periodic: bool,
+}
+
+impl<const D: usize> Geometry<D> {
+    /// The cell of a point.
+    #[inline]
+    fn cell(&self, p: &[f64; D]) -> Cell<D> {
+        core::array::from_fn(|k| {
+            let u = floor_to_i64((p[k] - self.origin[k]) * self.inv_cell[k]);
+            if self.periodic {
+                u.rem_euclid(self.dims[k]) as i32
+            } else if self.hashed {
+                u as i32
+            } else {
+                // Dense: one empty padding cell on each side.
+                (u.clamp(0, self.dims[k] - 3) + 1) as i32
+            }
+        })
+    }
+
+    /// The bucket of a cell (in range for dense and periodic cells).
+    #[inline]
+    fn bucket(&self, c: &Cell<D>) -> usize {
+        if self.hashed {
+            const PRIMES: [u64; 3] = [73_856_093, 19_349_663, 83_492_791];
+            let h = (0..D).fold(0u64, |h, k| {
+                h ^ (c[k] as u64).wrapping_mul(PRIMES[k % 3] << (k / 3))
+            });
+            let bits = self.buckets.trailing_zeros();
+            (h.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - bits)) as usize
+        } else {
+            (0..D)
+                .rev()
+                .fold(0usize, |b, k| b * self.dims[k] as usize + c[k] as usize)
+        }
+    }
+
+    /// The neighbour of `c` at `offset`, wrapped in a periodic grid; `None` outside a
+    /// dense one.
+    #[inline]
+    fn neighbour(&self, c: &Cell<D>, offset: &Cell<D>) -> Option<Cell<D>> {
+        let mut n = [0i32; D];
+        for k in 0..D {
+            let x = i64::from(c[k]) + i64::from(offset[k]);
+            n[k] = if self.periodic {
+                x.rem_euclid(self.dims[k]) as i32
+            } else if self.hashed {
+                x as i32
+            } else if x < 0 || x >= self.dims[k] {
+                return None;
+            } else {
+                x as i32
+            };
+        }
+        Some(n)
+    }
+
+    /// The unwrapped cell-coordinate range covering `[lo, hi]` on every axis.
+    fn range(&self, lo: &[f64; D], hi: &[f64; D]) -> ([i64; D], [i64; D]) {
+        let pad = i64::from(!self.periodic && !self.hashed);
+        let f = |p: &[f64; D], k: usize| {
+            ((p[k] - self.origin[k]) * self.inv_cell[k])
+                .floor()
+                .clamp(-4e18, 4e18) as i64
+                + pad
+        };
+        let mut a: [i64; D] = core::array::from_fn(|k| f(lo, k));
+        let mut b: [i64; D] = core::array::from_fn(|k| f(hi, k));
+        for k in 0..D {
+            if self.periodic {
+                if b[k] - a[k] + 1 >= self.dims[k] {
+                    (a[k], b[k]) = (0, self.dims[k] - 1);
+                }
+            } else if !self.hashed {
+                (a[k], b[k]) = (a[k].max(0), b[k].min(self.dims[k] - 1));
+            }
+        }
+        (a, b)
+    }
+}
+
+/// `⌊x⌋` as an integer (saturating), without a libm call: truncate, then step down for
+/// negative non-integers.
+#[inline]
+fn floor_to_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
+}
+
+/// The forward half of the neighbour offsets: those whose last non-zero component is
+/// positive (4 in 2D, 13 in 3D). With the cell itself they visit each adjacent pair of
+/// cells once.
+fn forward_offsets<const D: usize>() -> Vec<Cell<D>> {
+    let mut out = Vec::new();
+    for code in 0..3usize.pow(D as u32) {
+        let mut rest = code;
+        let o: Cell<D> = core::array::from_fn(|_| {
+            let d = [-1, 0, 1][rest % 3];
+            rest /= 3;
+            d
+        });
+        if o.iter().rev().find(|&&d| d != 0) == Some(&1) {
+            out.push(o);
+        }
+    }
+    out
+}
+
+/// One regular volume in bucket order.
+#[derive(Clone, Copy, Debug)]
+struct Entry<T: Real, const D: usize> {
+    proxy: Proxy<T, D>,
+    cell: Cell<D>,
+    id: u32,
+}
+
+/// A uniform-grid broad phase over boxes or balls.
+#[derive(Clone, Debug)]
+pub struct UniformGrid<T: Real, const D: usize> {
+    store: Store<T, D>,
+    layout: GridLayout<T, D>,
+    oversize_ratio: f64,
+    offsets: Vec<Cell<D>>,
+    geometry: Option<Geometry<D>>,
+    /// Half the cell width, rounded up: how far a regular centre can be from its box.
+    reach: f64,
+    start: Vec<u32>,
+    entries: Vec<Entry<T, D>>,
+    /// Sorted `(bucket, index)` keys of the regular volumes (kept for the next frame).
+    keys: Vec<u64>,
+    scratch: Vec<u64>,
+    counts: Vec<usize>,
+    /// Per volume: `true` if it is in the cells this frame.
+    in_cells: Vec<bool>,
+    /// Per volume: its bucket, or `u32::MAX` when it is not in the cells.
+    bucket_of: Vec<u32>,
+    regular: Vec<u32>,
+    oversized: Vec<u32>,
+    oversized_sweep: SweepCore<T, D>,
+    selection: Vec<f64>,
+    buffers: PairBuffers,
+}
+
+impl<T: Real, const D: usize> UniformGrid<T, D> {
+    /// A grid with the given layout and cells sized for volumes up to 2 × the median.
+    pub fn new(layout: GridLayout<T, D>) -> Self {
+        let mut store = Store::default();
+        if let GridLayout::Periodic(border) = &layout {
+            store.set_period(Some(border));
+        }
+        Self {
+            store,
+            layout,
+            oversize_ratio: 2.0,
+            offsets: forward_offsets(),
+            geometry: None,
+            reach: 0.0,
+            start: Vec::new(),
+            entries: Vec::new(),
+            keys: Vec::new(),
+            scratch: Vec::new(),
+            counts: Vec::new(),
+            in_cells: Vec::new(),
+            bucket_of: Vec::new(),
+            regular: Vec::new(),
+            oversized: Vec::new(),
+            oversized_sweep: SweepCore::default(),
+            selection: Vec::new(),
+            buffers: PairBuffers::default(),
+        }
+    }
+
+    /// A dense grid over the bounding box of each frame's centres.
+    pub fn dense() -> Self {
+        Self::new(GridLayout::Dense)
+    }
+
+    /// A hashed grid for unbounded worlds.
+    pub fn hashed() -> Self {
+        Self::new(GridLayout::Hashed)
+    }
+
+    /// A grid tiling the periodic domain `border` (minimum image).
+    pub fn periodic(border: Border<T, D>) -> Self {
+        Self::new(GridLayout::Periodic(border))
+    }
+
+    /// The same grid with volumes larger than `ratio` × the median edge length kept
+    /// out of the cells (`f64::INFINITY`: none; the cells then fit the largest volume).
+    ///
+    /// # Errors
+    /// `ratio` if it is NaN or below 1.
+    pub fn with_oversize_ratio(mut self, ratio: f64) -> Result<Self, carom_math::InvalidValue> {
+        carom_math::ensure_in_range("ratio", ratio.min(f64::MAX), 1.0, f64::MAX)?;
+        self.oversize_ratio = ratio;
+        Ok(self)
+    }
+
+    /// The layout.
+    pub fn layout(&self) -> &GridLayout<T, D> {
+        &self.layout
+    }
+
+    /// How many volumes the last update kept out of the cells.
+    pub fn oversized(&self) -> usize {
+        self.oversized.len()
+    }
+
+    /// The cell counts per axis of the last update (dense and periodic layouts).
+    pub fn dims(&self) -> Option<[usize; D]> {
+        let g = self.geometry.as_ref().filter(|g| !g.hashed)?;
+        // Dense grids carry one padding cell on each side.
+        let pad = if g.periodic { 0 } else { 2 };
+        Some(g.dims.map(|d| (d - pad) as usize))
+    }
+
+    /// Chooses the cell geometry for the regular volumes, or `None` when there is no
+    /// usable grid (no regular volume, or a periodic box under 3 cells wide).
+    fn choose_geometry(&self, cell_width: f64, scale: f64) -> Option<Geometry<D>> {
+        let n = self.regular.len();
+        if n == 0 {
+            return None;
+        }
+        let eps = T::EPSILON.to_f64();
+        let mut width = cell_width * (1.0 + 1.0 / 1024.0) + 16.0 * eps * scale;
+        if width.is_nan() || width <= 0.0 {
+            width = 1.0;
+        }
+        let max_cells = (8 * n + 64) as f64;
+        match &self.layout {
+            GridLayout::Periodic(border) => {
+                let (origin, len) = (border.min(), border.extents());
+                let mut dims: [i64; D] = core::array::from_fn(|k| {
+                    (len[k].to_f64() / width).floor().min(MAX_CELLS_PER_AXIS) as i64
+                });
+                let total: f64 = dims.iter().map(|&d| d.max(1) as f64).product();
+                if total > max_cells {
+                    let shrink = (total / max_cells).powf(1.0 / D as f64) * 1.01;
+                    dims = dims.map(|d| (d as f64 / shrink).floor() as i64);
+                }
+                if dims.iter().any(|&d| d < 3) {
+                    return None;
+                }
+                Some(Geometry {
+                    origin: core::array::from_fn(|k| origin[k].to_f64()),
+                    inv_cell: core::array::from_fn(|k| dims[k] as f64 / len[k].to_f64()),
+                    buckets: dims.iter().map(|&d| d as usize).product(),
+                    dims,
+                    hashed: false,
+                    periodic: true,
+                })
+            }
+            layout => {
+                let hashed = matches!(layout, GridLayout::Hashed);
+                let mut lo = [f64::INFINITY; D];
+                let mut hi = [f64::NEG_INFINITY; D];
+                for &i in &self.regular {
+                    let c = self.store.proxies[i as usize].center;
+                    for k in 0..D {
+                        lo[k] = lo[k].min(c[k].to_f64());
+                        hi[k] = hi[k].max(c[k].to_f64());
+                    }
+                }
+                let span = (0..D).fold(0.0_f64, |s, k| s.max(hi[k] - lo[k]));
+                width = width.max(span / MAX_CELLS_PER_AXIS);
+                // Dense grids get an empty padding cell on each side, so that every
+                // neighbour of an occupied cell exists.
+                let pad = if hashed { 1 } else { 3 };
+                let dims_for = |w: f64| -> [i64; D] {
+                    core::array::from_fn(|k| ((hi[k] - lo[k]) / w).floor() as i64 + pad)
+                };
+                let mut dims = dims_for(width);
+                if !hashed {
+                    let total: f64 = dims.iter().map(|&d| d as f64).product();
+                    if total > max_cells {
+                        width *= (total / max_cells).powf(1.0 / D as f64) * 1.01;
+                        dims = dims_for(width);
+                    }
+                }
+                Some(Geometry {
+                    origin: lo,
+                    inv_cell: [1.0 / width; D],
+                    buckets: if hashed {
+                        (2 * n).next_power_of_two().max(16)
+                    } else {
+                        dims.iter().map(|&d| d as usize).product()
+                    },
+                    dims,
+                    hashed,
+                    periodic: false,
+                })
+            }
+        }
+    }
+
+    /// Calls `f` with the position (in `entries`) of every regular volume whose cell
+    /// lies in the cell range covering `[lo, hi]`, or of every regular volume when that
+    /// range has more cells than there are volumes.
+    fn for_each_regular_near(&self, lo: &[f64; D], hi: &[f64; D], mut f: impl FnMut(usize)) {
+        let Some(g) = &self.geometry else { return };
+        let (a, b) = g.range(lo, hi);
+        let count = (0..D).try_fold(1u64, |acc, k| {
+            let span = u64::try_from(b[k] - a[k] + 1).unwrap_or(0);
+            acc.checked_mul(span)
+        });
+        match count {
+            Some(0) => {}
+            Some(c) if c <= self.entries.len() as u64 => {
+                let mut cur = a;
+                'cells: loop {
+                    let cell: Cell<D> = core::array::from_fn(|k| {
+                        if g.periodic {
+                            cur[k].rem_euclid(g.dims[k]) as i32
+                        } else {
+                            cur[k] as i32
+                        }
+                    });
+                    let bucket = g.bucket(&cell);
+                    for m in self.start[bucket] as usize..self.start[bucket + 1] as usize {
+                        if self.entries[m].cell == cell {
+                            f(m);
+                        }
+                    }
+                    for k in 0..D {
+                        if cur[k] < b[k] {
+                            cur[k] += 1;
+                            continue 'cells;
+                        }
+                        cur[k] = a[k];
+                    }
+                    break;
+                }
+            }
+            _ => (0..self.entries.len()).for_each(f),
+        }
+    }
+
+    /// Emits the pairs among regular volumes starting at entry positions `regular`, the
+    /// pairs of the oversized volumes `oversized` (indices into the oversized list) with
+    /// regular ones, and the oversized–oversized pairs of that share.
+    fn search(
+        &self,
+        regular: core::ops::Range<usize>,
+        oversized: core::ops::Range<usize>,
+        emit: &mut Emitter<'_>,
+    ) {
+        match &self.geometry {
+            Some(g) if !g.hashed && !g.periodic => self.search_dense(g, regular, emit),
+            Some(g) => self.search_general(g, regular, emit),
+            None => {}
+        }
+        self.search_oversized(oversized, emit);
+    }
+
+    /// The regular pairs of a dense grid: thanks to the padding, the forward neighbours
+    /// of the cell with bucket `b` are the buckets `b + o` for fixed linear offsets `o`.
+    fn search_dense(
+        &self,
+        g: &Geometry<D>,
+        regular: core::ops::Range<usize>,
+        emit: &mut Emitter<'_>,
+    ) {
+        let balls = self.store.balls;
+        let mut linear = [0isize; 13];
+        for (l, offset) in linear.iter_mut().zip(&self.offsets) {
+            let mut stride = 1isize;
+            for (&o, &dim) in offset.iter().zip(&g.dims) {
+                *l += o as isize * stride;
+                stride *= dim as isize;
+            }
+        }
+        let linear = &linear[..self.offsets.len()];
+        for k in regular {
+            let a = &self.entries[k];
+            let base = entry_key(self.keys[k]) as usize;
+            for b in &self.entries[k + 1..self.start[base + 1] as usize] {
+                if overlap(&a.proxy, &b.proxy, balls, None) {
+                    emit.push(a.id, b.id);
+                }
+            }
+            for &offset in linear {
+                let bucket = base.wrapping_add_signed(offset);
+                let (from, to) = (self.start[bucket] as usize, self.start[bucket + 1] as usize);
+                for b in &self.entries[from..to] {
+                    if overlap(&a.proxy, &b.proxy, balls, None) {
+                        emit.push(a.id, b.id);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The regular pairs of a hashed or periodic grid (wrapped neighbours, colliding
+    /// cells told apart by their coordinates).
+    fn search_general(
+        &self,
+        g: &Geometry<D>,
+        regular: core::ops::Range<usize>,
+        emit: &mut Emitter<'_>,
+    ) {
+        let (balls, period) = (self.store.balls, self.store.period.as_ref());
+        for k in regular {
+            let a = &self.entries[k];
+            let end = self.start[g.bucket(&a.cell) + 1] as usize;
+            for b in &self.entries[k + 1..end] {
+                if b.cell == a.cell && overlap(&a.proxy, &b.proxy, balls, period) {
+                    emit.push(a.id, b.id);
+                }
+            }
+            for offset in &self.offsets {
+                let Some(cell) = g.neighbour(&a.cell, offset) else {
+                    continue;
+                };
+                let bucket = g.bucket(&cell);
+                for b in &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
+                {
+                    if b.cell == cell && overlap(&a.proxy, &b.proxy, balls, period) {
+                        emit.push(a.id, b.id);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The pairs of the oversized volumes at list positions `oversized`: with the
+    /// regular volumes near them, and with each other.
+    fn search_oversized(&self, oversized: core::ops::Range<usize>, emit: &mut Emitter<'_>) {
+        let (balls, period) = (self.store.balls, self.store.period.as_ref());
+        for &i in &self.oversized[oversized.clone()] {
+            let p = &self.store.proxies[i as usize];
+            let lo = core::array::from_fn(|k| p.aabb.min()[k].to_f64() - self.reach);
+            let hi = core::array::from_fn(|k| p.aabb.max()[k].to_f64() + self.reach);
+            self.for_each_regular_near(&lo, &hi, |m| {
+                let b = &self.entries[m];
+                if overlap(p, &b.proxy, balls, period) {
+                    emit.push(i, b.id);
+                }
+            });
+        }
+        if period.is_some() {
+            for (x, &i) in self
+                .oversized
+                .iter()
+                .enumerate()
+                .skip(oversized.start)
+                .take(oversized.len())
+            {
+                for &j in &self.oversized[x + 1..] {
+                    if self.store.overlap(i as usize, j as usize) {
+                        emit.push(i, j);
+                    }
+                }
+            }
+        } else {
+            // The sweep sorted exactly the oversized list: split its positions the same way.
+            self.oversized_sweep.sweep(oversized, balls, emit);
+        }
+    }
+
+    /// Query helper: regular candidates near `[lo, hi]` grown by the reach, and the
+    /// oversized ones, filtered by `hit`.
+    fn query(
+        &self,
+        lo: &Vector<T, D>,
+        hi: &Vector<T, D>,
+        hit: impl Fn(usize) -> bool,
+        out: &mut Vec<u32>,
+    ) {
+        out.clear();
+        let lo64 = core::array::from_fn(|k| lo[k].to_f64() - self.reach);
+        let hi64 = core::array::from_fn(|k| hi[k].to_f64() + self.reach);
+        self.for_each_regular_near(&lo64, &hi64, |m| {
+            let id = self.entries[m].id;
+            if hit(id as usize) {
+                out.push(id);
+            }
+        });
+        if self.store.period.is_some() {
+            out.extend(self.oversized.iter().copied().filter(|&j| hit(j as usize)));
+        } else {
+            let axis = self.oversized_sweep.axis();
+            self.oversized_sweep.candidates(lo[axis], hi[axis], |j| {
+                if hit(j as usize) {
+                    out.push(j);
+                }
+            });
+        }
+        out.sort_unstable();
+    }
+}
+
+impl<T: Real, const D: usize> UniformGrid<T, D> {
+    /// The update, its element-wise passes on the rayon pool when `parallel`.
+    fn rebuild(&mut self, volumes: Volumes<'_, T, D>, parallel: bool) {
+        self.store.load(volumes, parallel);
+        let n = self.store.len();
+        let proxies = &self.store.proxies;
+
+        // Regular volumes (in the cells) and oversized ones.
+        let threshold = self.oversize_ratio
+            * sampled_median(n, |i| proxies[i].extent().to_f64(), &mut self.selection);
+        let regular = |i: usize| proxies[i].extent().to_f64() <= threshold;
+        self.in_cells.clear();
+        extend_indexed(&mut self.in_cells, n, parallel, regular);
+        let cell_width = max_indexed(n, parallel, |i| {
+            if regular(i) {
+                proxies[i].extent().to_f64()
+            } else {
+                0.0
+            }
+        });
+        let scale = max_indexed(n, parallel, |i| {
+            let p = &proxies[i];
+            if regular(i) {
+                p.center.amax().to_f64() + p.extent().to_f64()
+            } else {
+                0.0
+            }
+        });
+        self.regular.clear();
+        self.oversized.clear();
+        for (i, &inside) in self.in_cells.iter().enumerate() {
+            if inside {
+                self.regular.push(i as u32);
+            } else {
+                self.oversized.push(i as u32);
+            }
+        }
+        self.geometry = self.choose_geometry(cell_width, scale);
+        if self.geometry.is_none() {
+            self.oversized.clear();
+            self.oversized.extend(0..n as u32);
+            self.regular.clear();
+            self.in_cells.fill(false);
+        }
+        self.reach = match &self.geometry {
+            Some(g) => (0..D).fold(0.0_f64, |r, k| r.max(0.5 / g.inv_cell[k])) * (1.0 + 1e-9),
+            None => 0.0,
+        };
+
+        // Sort the regular volumes by bucket as (bucket, index) keys: an insertion sort
+        // from the previous frame's order when the set of regular volumes is unchanged
+        // (coherent frames: few volumes change cells), a radix sort otherwise. Both
+        // give the same order; unlike a counting sort straight into the bucket array,
+        // neither scatters at random over memory the size of the grid.
+        self.entries.clear();
+        self.start.clear();
+        let Some(g) = self.geometry else {
+            self.keys.clear();
+            self.build_oversized(parallel);
+            return;
+        };
+        let proxies = &self.store.proxies;
+        let cell_of = |id: u32| g.cell(&proxies[id as usize].center.map(Real::to_f64).into());
+        // Buckets in index order, a sequential pass over the volumes, so that the
+        // re-keying in sorted order below reads 4 bytes per volume at random, not a
+        // whole volume.
+        let in_cells = &self.in_cells;
+        self.bucket_of.clear();
+        extend_indexed(&mut self.bucket_of, n, parallel, |i| {
+            if in_cells[i] {
+                g.bucket(&cell_of(i as u32)) as u32
+            } else {
+                u32::MAX
+            }
+        });
+        let bucket_of = &self.bucket_of;
+        let regular = self.regular.len();
+        let same_set = self.keys.len() == regular
+            && self
+                .keys
+                .iter()
+                .all(|&e| bucket_of[entry_id(e) as usize] != u32::MAX);
+        let coherent = same_set && {
+            map_in_place(&mut self.keys, parallel, |e| {
+                entry(bucket_of[entry_id(e) as usize], entry_id(e))
+            });
+            insertion_sort_bounded(&mut self.keys, 4 * regular)
+        };
+        if !coherent {
+            self.keys.clear();
+            let ids = &self.regular;
+            extend_indexed(&mut self.keys, regular, parallel, |x| {
+                entry(bucket_of[ids[x] as usize], ids[x])
+            });
+            radix_sort_by_key(&mut self.keys, &mut self.scratch, &mut self.counts);
+        }
+        // start[b] = the first sorted position whose bucket is >= b (sequential fill).
+        self.start.resize(g.buckets + 1, 0);
+        let mut b = 0;
+        for (k, &e) in self.keys.iter().enumerate() {
+            let bucket = entry_key(e) as usize;
+            self.start[b..=bucket].fill(k as u32);
+            b = bucket + 1;
+        }
+        self.start[b..].fill(regular as u32);
+        let keys = &self.keys;
+        extend_indexed(&mut self.entries, regular, parallel, |k| {
+            let id = entry_id(keys[k]);
+            Entry {
+                proxy: proxies[id as usize],
+                cell: cell_of(id),
+                id,
+            }
+        });
+        self.build_oversized(parallel);
+    }
+
+    /// Sorts the oversized volumes for their sweep (open space only).
+    fn build_oversized(&mut self, parallel: bool) {
+        if self.store.period.is_none() {
+            self.oversized_sweep.build(
+                &self.store,
+                Some(&self.oversized),
+                SortPolicy::Radix,
+                parallel,
+            );
+        }
+    }
+}
+
+impl<T: Real, const D: usize> BroadPhase<T, D> for UniformGrid<T, D> {
+    fn update(&mut self, volumes: Volumes<'_, T, D>) {
+        self.rebuild(volumes, false);
+    }
+
+    fn len(&self) -> usize {
+        self.store.len()
+    }
+
+    fn pairs(&mut self, out: &mut Vec<Pair>) {
+        let n = self.store.len();
+        let mut buffers = core::mem::take(&mut self.buffers);
+        buffers.prepare(n, 1, 1);
+        self.search(
+            0..self.entries.len(),
+            0..self.oversized.len(),
+            &mut buffers.emitter(),
+        );
+        buffers.sort_into(out);
+        self.buffers = buffers;
+    }
+
+    fn query_aabb(&self, query: &Aabb<T, D>, out: &mut Vec<u32>) {
+        self.query(
+            &query.min(),
+            &query.max(),
+            |j| self.store.hits_box(j, query),
+            out,
+        );
+    }
+
+    fn query_ball(&self, center: &Vector<T, D>, radius: T, out: &mut Vec<u32>) {
+        if !radius.finite() || radius < T::zero() {
+            out.clear();
+            return;
+        }
+        let r = Vector::<T, D>::repeat(radius);
+        self.query(
+            &(center - r),
+            &(center + r),
+            |j| self.store.hits_ball(j, center, radius),
+            out,
+        );
+    }
+}
+
+#[cfg(feature = "parallel")]
+impl<T: Real, const D: usize> crate::ParallelBroadPhase<T, D> for UniformGrid<T, D> {
+    fn par_update(&mut self, volumes: Volumes<'_, T, D>) {
+        self.rebuild(volumes, true);
+    }
+
+    fn par_pairs(&mut self, out: &mut Vec<Pair>) {
+        use rayon::prelude::*;
+        let (n, r, m) = (self.store.len(), self.entries.len(), self.oversized.len());
+        let chunks = crate::parallel_chunks();
+        let mut buffers = core::mem::take(&mut self.buffers);
+        buffers.prepare(n, chunks, chunks);
+        let this = &*self;
+        buffers
+            .emitters()
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, mut emit)| {
+                let regular = crate::chunk_range(c, chunks, r);
+                this.search(regular, crate::chunk_range(c, chunks, m), &mut emit);
+            });
+        buffers.par_sort_into(out);
+        self.buffers = buffers;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn forward_offsets_are_half_of_the_neighbours() {
+        assert_eq!(forward_offsets::<2>().len(), 4);
+        assert_eq!(forward_offsets::<3>().len(), 13);
+        let o = forward_offsets::<2>();
+        for a in &o {
+            assert!(!o.contains(&[-a[0], -a[1]]), "{a:?} and its opposite");
+        }
+    }
+}
