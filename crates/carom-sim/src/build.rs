@@ -1,0 +1,36 @@
+//! Building the engine a [`Plan`] chose: the one entry point `carom run` calls.
+
+use carom_math::{Real, Space};
+use carom_toi::Direction;
+use nalgebra::Const;
+
+use crate::engine::{EngineKind, Simulation};
+use crate::plan::Plan;
+use crate::scene::{Scene, SceneError};
+use crate::stepped::SteppedEngine;
+
+/// The engine `plan` chose for `scene`, running in `direction`, behind the common
+/// [`Simulation`] face.
+///
+/// # Errors
+/// The scene's [`SceneError`] (every engine validates the scene), or an option the
+/// engine cannot honour, naming the field or flag.
+pub fn build<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    plan: &Plan,
+    direction: Direction,
+) -> Result<Box<dyn Simulation<T, D>>, SceneError>
+where
+    Const<D>: Space<T, D>,
+{
+    match plan.engine {
+        EngineKind::Stepped => Ok(Box::new(SteppedEngine::new(scene, plan, direction)?)),
+        EngineKind::Event => {
+            scene.validate()?;
+            Err(SceneError::new(
+                "--engine",
+                "the event-driven engine is not in this build; use --engine stepped",
+            ))
+        }
+    }
+}
