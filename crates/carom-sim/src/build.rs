@@ -1,4 +1,4 @@
-//! Building the engine a [`Plan`] chose.
+//! Building the engine a [`Plan`] chose: the one entry point `carom run` calls.
 
 use carom_math::{Real, Space};
 use carom_toi::Direction;
@@ -8,11 +8,14 @@ use crate::engine::{EngineKind, Simulation};
 use crate::event::EventEngine;
 use crate::plan::Plan;
 use crate::scene::{Scene, SceneError};
+use crate::stepped::SteppedEngine;
 
-/// The engine of `plan` for `scene`, running in `direction`.
+/// The engine `plan` chose for `scene`, running in `direction`, behind the common
+/// [`Simulation`] face.
 ///
 /// # Errors
-/// The scene breaks a rule of the contract or cannot run on the chosen engine.
+/// The scene's [`SceneError`] (every engine validates the scene), or an option the
+/// engine cannot honour, naming the field or flag.
 pub fn build<T: Real, const D: usize>(
     scene: &Scene<T, D>,
     plan: &Plan,
@@ -23,9 +26,6 @@ where
 {
     match plan.engine {
         EngineKind::Event => Ok(Box::new(EventEngine::new(scene, plan, direction)?)),
-        EngineKind::Stepped => Err(SceneError::new(
-            "",
-            "the time-stepped engine is not part of this build yet",
-        )),
+        EngineKind::Stepped => Ok(Box::new(SteppedEngine::new(scene, plan, direction)?)),
     }
 }

@@ -8,6 +8,8 @@
 //! * [`Simulation`]: what every engine offers; [`build`] constructs the planned one.
 //! * [`run`] and [`observe`]: driving a run (sample times, the summary) and measuring it
 //!   (energy, momentum, state hashes).
+//! * [`stepped`]: the time-stepped engine (any integrator, continuous collision
+//!   detection, parallel and deterministic).
 
 mod build;
 mod engine;
@@ -17,6 +19,7 @@ pub mod plan;
 pub mod run;
 pub mod scene;
 pub mod scenes;
+pub mod stepped;
 
 pub use build::build;
 pub use engine::{

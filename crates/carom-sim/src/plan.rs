@@ -149,6 +149,50 @@ pub fn event_engine_limitation<T: Real, const D: usize>(
     None
 }
 
+/// Below this many balls the stepped engine's automatic broad phase tests every pair.
+pub const STEPPED_BRUTE_FORCE_BELOW: usize = 64;
+
+/// The broad phase the stepped engine builds for `scene` when asked for `choice`.
+///
+/// `Auto` resolves to: every pair (brute force) below [`STEPPED_BRUTE_FORCE_BELOW`]
+/// balls; a uniform grid in a periodic border (the only structure besides brute force
+/// that wraps around); sweep-and-prune when ball radii span more than a factor 8 (a grid
+/// sized for the median ball sends every large ball down its slow oversized path);
+/// a uniform grid otherwise. The stepped engine enters each ball as the box it can reach
+/// within a step, so fast balls are large volumes too; the grid handles a few of them on
+/// its oversized path.
+///
+/// # Errors
+/// `--broad sap` and `--broad kd` in a periodic border (they have no periodic mode).
+pub fn stepped_broad_phase<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    choice: BroadChoice,
+) -> Result<BroadChoice, PlanError> {
+    let periodic = scene.world.border.as_ref().is_some_and(|b| b.periodic);
+    match choice {
+        BroadChoice::Sap | BroadChoice::Kd if periodic => Err(PlanError(format!(
+            "--broad {choice}: the scene has a periodic border, which only --broad grid and --broad brute handle"
+        ))),
+        BroadChoice::Auto => {
+            let n = scene.balls.len();
+            let (lo, hi) = scene
+                .balls
+                .iter()
+                .fold((T::INFINITY, T::zero()), |(lo, hi), b| {
+                    (lo.min(b.radius), hi.max(b.radius))
+                });
+            Ok(if n < STEPPED_BRUTE_FORCE_BELOW {
+                BroadChoice::Brute
+            } else if !periodic && hi > T::lit(8.0) * lo {
+                BroadChoice::Sap
+            } else {
+                BroadChoice::Grid
+            })
+        }
+        other => Ok(other),
+    }
+}
+
 /// Decides the engine and its options for `scene`.
 ///
 /// # Errors
@@ -188,6 +232,9 @@ pub fn plan<T: Real, const D: usize>(
         return Err(PlanError(format!(
             "--dt: must be a finite step > 0, got {dt}"
         )));
+    }
+    if engine == EngineKind::Stepped {
+        stepped_broad_phase(scene, options.broad)?;
     }
     if engine == EngineKind::Event && matches!(options.broad, BroadChoice::Sap | BroadChoice::Kd) {
         return Err(PlanError(format!(

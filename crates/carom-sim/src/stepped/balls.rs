@@ -1,0 +1,219 @@
+//! The balls as struct-of-arrays: properties, the state between steps, and the motion
+//! within the current step as one straight segment per ball.
+//!
+//! Between steps the state is `pos`, `vel`, `spin` (at the engine's current time). During
+//! a step of length `h` these arrays hold the state **at the end of the step** as known
+//! so far, and each ball moves on a segment: from `seg_x` at in-step time `seg_t`, along
+//! the chord velocity `chord`, to `pos` at `h`:
+//!
+//! ```text
+//! x(s) = seg_x + chord · (s − seg_t),          seg_t <= s <= h
+//! v(s) = seg_v + (vel − seg_v) · (s − seg_t)/(h − seg_t)    (physical velocity)
+//! ```
+//!
+//! At the start of a step every segment is the integrator's step: `seg_x` the old
+//! position, `pos` the integrated one, `chord = (pos − seg_x)/h`. A collision at `s`
+//! restarts the segment at `s` ([`BallArrays::restart`]) and replaces its end. The
+//! physical velocity is interpolated linearly, which is exact for constant acceleration
+//! (gravity) and first-order otherwise; positions follow the chord, which is what the
+//! continuous collision detection sweeps, so "no overlap along the chords" is exactly
+//! what the engine guarantees.
+
+use carom_math::{Real, Space, Vector};
+use nalgebra::Const;
+
+use crate::engine::Angular;
+use crate::scene::{Scene, SceneError};
+
+/// Every ball's properties, state and current segment, in scene order.
+#[derive(Clone, Debug)]
+pub(crate) struct BallArrays<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Radii.
+    pub(crate) radius: Vec<T>,
+    /// `1/m`.
+    pub(crate) inverse_mass: Vec<T>,
+    /// `1/I` of the ball about its centre (`I = f m r²`, disk or solid sphere).
+    pub(crate) inverse_inertia: Vec<T>,
+    /// Each ball's restitution (its override, or the world's).
+    pub(crate) restitution: Vec<T>,
+    /// Position at the end of the step (the state between steps).
+    pub(crate) pos: Vec<Vector<T, D>>,
+    /// Velocity at the end of the step.
+    pub(crate) vel: Vec<Vector<T, D>>,
+    /// Angular velocity at the end of the step.
+    pub(crate) spin: Vec<Angular<T, D>>,
+    /// In-step time the current segment starts at.
+    pub(crate) seg_t: Vec<T>,
+    /// Position at `seg_t`.
+    pub(crate) seg_x: Vec<Vector<T, D>>,
+    /// Physical velocity at `seg_t`.
+    pub(crate) seg_v: Vec<Vector<T, D>>,
+    /// Angular velocity at `seg_t`.
+    pub(crate) seg_w: Vec<Angular<T, D>>,
+    /// The segment's constant velocity.
+    pub(crate) chord: Vec<Vector<T, D>>,
+    /// Bumped whenever the segment changes: events predicted before are stale.
+    pub(crate) version: Vec<u32>,
+    /// Resting on an immovable surface, directly or through other supported balls, in
+    /// the current step (see `response`: shock propagation).
+    pub(crate) supported: Vec<bool>,
+}
+
+impl<T: Real, const D: usize> BallArrays<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// The balls of a validated `scene`, velocities multiplied by `sign` (−1 for a
+    /// backward run), at rest spinning.
+    ///
+    /// # Errors
+    /// `balls[i]` if `m r²` is out of the range of the precision (its inverse would not
+    /// be finite and positive).
+    pub(crate) fn from_scene(scene: &Scene<T, D>, sign: T) -> Result<Self, SceneError> {
+        let n = scene.balls.len();
+        let inertia = <Const<D> as Space<T, D>>::ball_inertia_factor();
+        let zero_spin = <Const<D> as Space<T, D>>::angular_zero();
+        let balls = Self {
+            radius: scene.balls.iter().map(|b| b.radius).collect(),
+            inverse_mass: scene.balls.iter().map(|b| T::one() / b.mass).collect(),
+            inverse_inertia: scene
+                .balls
+                .iter()
+                .map(|b| T::one() / (inertia * b.mass * b.radius * b.radius))
+                .collect(),
+            restitution: scene
+                .balls
+                .iter()
+                .map(|b| b.restitution.unwrap_or(scene.world.restitution))
+                .collect(),
+            pos: scene.balls.iter().map(|b| b.pos).collect(),
+            vel: scene.balls.iter().map(|b| b.vel * sign).collect(),
+            spin: vec![zero_spin; n],
+            seg_t: vec![T::zero(); n],
+            seg_x: vec![Vector::zeros(); n],
+            seg_v: vec![Vector::zeros(); n],
+            seg_w: vec![zero_spin; n],
+            chord: vec![Vector::zeros(); n],
+            version: vec![0; n],
+            supported: vec![false; n],
+        };
+        let bad = |x: &T| !(x.finite() && *x > T::zero());
+        let bad_mass = balls.inverse_mass.iter().position(bad);
+        match bad_mass.or_else(|| balls.inverse_inertia.iter().position(bad)) {
+            Some(i) => Err(SceneError::new(
+                format!("balls[{i}]"),
+                "mass and mass · radius² must have finite positive inverses in this precision",
+            )),
+            None => Ok(balls),
+        }
+    }
+
+    /// The number of balls.
+    pub(crate) fn len(&self) -> usize {
+        self.radius.len()
+    }
+
+    /// Position of ball `i` at in-step time `s` on its segment.
+    #[inline]
+    pub(crate) fn position_at(&self, i: usize, s: T) -> Vector<T, D> {
+        self.seg_x[i] + self.chord[i] * (s - self.seg_t[i])
+    }
+
+    /// The fraction of the segment of ball `i` elapsed at `s` (0 for an empty segment).
+    #[inline]
+    fn fraction(&self, i: usize, s: T, h: T) -> T {
+        let span = h - self.seg_t[i];
+        if span > T::zero() {
+            ((s - self.seg_t[i]) / span).min(T::one())
+        } else {
+            T::zero()
+        }
+    }
+
+    /// Physical velocity and spin of ball `i` at `s` (step length `h`).
+    #[inline]
+    pub(crate) fn velocity_at(&self, i: usize, s: T, h: T) -> (Vector<T, D>, Angular<T, D>) {
+        let f = self.fraction(i, s, h);
+        (
+            self.seg_v[i] + (self.vel[i] - self.seg_v[i]) * f,
+            self.seg_w[i] + (self.spin[i] - self.seg_w[i]) * f,
+        )
+    }
+
+    /// Starts a new segment of ball `i` at `s`, on the same chord and with the same end.
+    pub(crate) fn restart(&mut self, i: usize, s: T, h: T) {
+        let x = self.position_at(i, s);
+        let (v, w) = self.velocity_at(i, s, h);
+        self.seg_x[i] = x;
+        self.seg_v[i] = v;
+        self.seg_w[i] = w;
+        self.seg_t[i] = s;
+    }
+
+    /// Sets the end of the segment of ball `i` (length `h − seg_t > 0`), and the chord.
+    pub(crate) fn set_end(
+        &mut self,
+        i: usize,
+        h: T,
+        x: Vector<T, D>,
+        v: Vector<T, D>,
+        w: Angular<T, D>,
+    ) {
+        let span = h - self.seg_t[i];
+        self.chord[i] = if span > T::zero() {
+            (x - self.seg_x[i]) / span
+        } else {
+            v
+        };
+        self.pos[i] = x;
+        self.vel[i] = v;
+        self.spin[i] = w;
+    }
+
+    /// Changes ball `i`'s velocity by `dv` (and spin by `dw`) from the segment start on,
+    /// without re-integrating: the chord and the physical velocity shift alike.
+    pub(crate) fn nudge(&mut self, i: usize, h: T, dv: &Vector<T, D>, dw: &Angular<T, D>) {
+        self.chord[i] += dv;
+        self.seg_v[i] += dv;
+        self.vel[i] += dv;
+        self.seg_w[i] += *dw;
+        self.spin[i] += *dw;
+        self.pos[i] = self.seg_x[i] + self.chord[i] * (h - self.seg_t[i]);
+    }
+
+    /// Holds ball `i` on several supports: its chord becomes `u` from the segment start
+    /// on, and so does its physical velocity (the forces of the rest of the step are
+    /// what the supports cancel).
+    pub(crate) fn hold(&mut self, i: usize, h: T, u: Vector<T, D>) {
+        self.chord[i] = u;
+        self.seg_v[i] = u;
+        self.vel[i] = u;
+        self.pos[i] = self.seg_x[i] + u * (h - self.seg_t[i]);
+    }
+
+    /// Changes the chord of ball `i` by `du` (and its spin by `dw`) from the segment start
+    /// on, for a resting contact along the unit normal `n`: the physical velocity shifts
+    /// by the same amount over the whole segment, and its component along `n` becomes the
+    /// chord's, so that a ball held on a surface does not end the step moving into it.
+    pub(crate) fn shift_chord(
+        &mut self,
+        i: usize,
+        h: T,
+        du: &Vector<T, D>,
+        dw: &Angular<T, D>,
+        n: &Vector<T, D>,
+    ) {
+        self.chord[i] += du;
+        let along = self.chord[i].dot(n);
+        for v in [&mut self.seg_v[i], &mut self.vel[i]] {
+            *v += du;
+            *v += n * (along - v.dot(n));
+        }
+        self.seg_w[i] += *dw;
+        self.spin[i] += *dw;
+        self.pos[i] = self.seg_x[i] + self.chord[i] * (h - self.seg_t[i]);
+    }
+}

@@ -1,0 +1,952 @@
+//! The time-stepped engine: fixed steps of any integrator, with continuous collision
+//! detection so that no ball passes through another ball, a box or a wall at any speed.
+//!
+//! For scenes an exact event-driven engine cannot serve (drag, arbitrary forces,
+//! kinematic paddles driven from Rust, 3D stick clusters) and for engine authors who know
+//! the game loop. Each step of length `h`:
+//!
+//! 1. **Integrate** every ball with carom-integrate's [`Stepper`] (any [`Integrator`]),
+//!    in parallel chunks. Each ball's motion within the step is the straight segment
+//!    (chord) from its old to its new position.
+//! 2. **Broad phase**: each ball's reach box (the ball grown by the distance it moves) and
+//!    each box's swept box go into carom-broad ([`BroadChoice`](crate::plan::BroadChoice)), in parallel.
+//! 3. **Narrow phase**: carom-toi's exact time of impact along the chords for every pair
+//!    the broad phase returns (ball–ball, ball–box, ball–wall), in parallel.
+//! 4. **Sub-step event loop**: the earliest contact of the step is processed (a
+//!    carom-response impulse, the rest of the step re-integrated, a resting correction if
+//!    the paths still close: see `response`), the balls it changed are predicted again,
+//!    and so on to the end of the step. A ball bouncing a thousand times between a box
+//!    and a wall within one step bounces a thousand times.
+//!
+//! Everything that runs in parallel computes each ball or pair on its own and merges in
+//! a fixed order; the event loop is sequential with a total order on events. Results are
+//! bit-identical for any number of threads and across runs.
+//!
+//! The work per step is bounded by [`SteppedEngine::set_event_budget`]: a step that would
+//! need more contacts than the budget stops every ball where it is for the rest of that
+//! step (velocities kept, no overlap created) and counts it in [`StepStats`]; nothing is
+//! dropped silently. `docs/stepped.md` has the derivations, the policies and the
+//! measurements against rapier2d.
+
+mod balls;
+mod forces;
+mod narrow;
+mod obstacles;
+mod response;
+mod rest;
+mod sweep;
+
+use std::collections::BinaryHeap;
+
+use carom_geometry::Border;
+use carom_integrate::{Bodies, Integrator, Stepper, TimeStep};
+use carom_math::{Real, Space, Vector, ensure_finite_vector};
+use carom_toi::Direction;
+use nalgebra::Const;
+use rayon::prelude::*;
+
+use self::balls::BallArrays;
+use self::forces::WorldForces;
+use self::narrow::{Event, Narrow, Overflow, Pending, Target};
+use self::obstacles::BoxArrays;
+use self::response::{Contacts, Effect, RestSets, Rules, Surface};
+use self::rest::{Support, Touch};
+use self::sweep::{CHUNK, REACH_STEPS, Sweep, path_box};
+use crate::engine::{BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation};
+use crate::plan::{DEFAULT_DT, Plan, stepped_broad_phase};
+use crate::scene::{Inelastic, Scene, SceneError};
+
+/// How often [`Observer::progress`] is called: every this many steps.
+const PROGRESS_EVERY: u64 = 256;
+
+/// Fewer balls than this are stepped on one thread (the result is the same).
+const PARALLEL_MIN: usize = 2048;
+
+/// What the engine did beyond the collisions it reports: for tests, reports and tuning.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepStats {
+    /// Steps taken (full and shortened).
+    pub steps: u64,
+    /// Contacts processed (collisions and resting contacts).
+    pub contacts: u64,
+    /// Contacts that were resting support rather than collisions: no impulse faster than
+    /// gravity adds in one step, only a correction of the paths (not reported to the
+    /// observer, not counted in [`Counters`]).
+    pub resting: u64,
+    /// Broad-phase builds: when balls left their reach boxes (about every
+    /// 4 steps in a gas), every window in a periodic domain, and
+    /// every window cut short.
+    pub broad_builds: u64,
+    /// Windows cut short: too many escapees, or a ball too fast for the periodic window.
+    pub rebuilds: u64,
+    /// The most contacts any single step needed.
+    pub max_contacts_in_step: u64,
+    /// Steps that exhausted the event budget (see [`SteppedEngine::set_event_budget`]).
+    pub capped_steps: u64,
+    /// The simulated time those steps spent frozen (s).
+    pub frozen_time: f64,
+}
+
+/// The step grid: internal time `s` (forward in the run's direction), grid times `k·dt`.
+#[derive(Clone, Copy, Debug)]
+struct Clock<T: Real> {
+    dt: f64,
+    /// The last grid index at or before `s`.
+    k: u64,
+    /// The internal time.
+    s: T,
+    /// `+1` forward, `−1` backward.
+    sign: T,
+}
+
+impl<T: Real> Clock<T> {
+    fn grid(&self, k: u64) -> T {
+        T::lit(k as f64 * self.dt)
+    }
+}
+
+/// The time-stepped engine (see the [module documentation](self)).
+pub struct SteppedEngine<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    balls: BallArrays<T, D>,
+    boxes: BoxArrays<T, D>,
+    border: Option<Border<T, D>>,
+    periodic: Option<Border<T, D>>,
+    stepper: Stepper<T, D, WorldForces<T, D>>,
+    rules: Rules<T, D>,
+    rest: RestSets<T, D>,
+    sweep: Sweep<T, D>,
+    queue: BinaryHeap<Pending<T, D>>,
+    chunk_events: Vec<Vec<Event<T, D>>>,
+    chunk_status: Vec<Result<(), Overflow>>,
+    candidates: Vec<u32>,
+    touches: [Vec<Touch<T, D>>; 2],
+    clock: Clock<T>,
+    counters: Counters,
+    stats: StepStats,
+    pipeline: Vec<String>,
+    event_budget: u64,
+    resting_floor: T,
+    /// The largest distance a ball may move in one window of a periodic domain.
+    periodic_reach: T,
+    escape_bound: usize,
+}
+
+/// How a window of the event loop ended.
+enum WindowEnd<T> {
+    /// At its planned end.
+    Done,
+    /// Early, at this in-step time: rebuild the broad phase from there.
+    Cut(T),
+    /// The event budget ran out at this in-step time.
+    Budget(T),
+}
+
+impl<T: Real, const D: usize> SteppedEngine<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// The engine for `scene` with the planner's `plan` (integrator, step, broad phase;
+    /// unset values take the defaults: semi-implicit Euler, [`DEFAULT_DT`], the automatic
+    /// broad phase), running in `direction`.
+    ///
+    /// # Errors
+    /// The first rule of [`Scene::validate`] the scene breaks; `--dt` if the step is not
+    /// finite and positive in this precision; `--broad` for a broad phase that cannot
+    /// serve a periodic border; `world.border` for a periodic border too small for its
+    /// balls (two ball diameters must fit in half a period); `world.inelastic` for stick
+    /// clusters, which this engine does not simulate yet.
+    pub fn new(scene: &Scene<T, D>, plan: &Plan, direction: Direction) -> Result<Self, SceneError> {
+        scene.validate()?;
+        let n = scene.balls.len();
+        if u32::try_from(n + scene.boxes.len()).is_err() {
+            return Err(SceneError::new("balls", "more than 2^32 balls and boxes"));
+        }
+        if scene.world.inelastic == Inelastic::Stick
+            && (scene.world.restitution == T::zero()
+                || scene.balls.iter().any(|b| b.restitution == Some(T::zero())))
+        {
+            return Err(SceneError::new(
+                "world.inelastic",
+                "\"stick\" clusters are not simulated by the stepped engine; use --engine event (2D) or inelastic = \"slide\"",
+            ));
+        }
+        let dt = plan.dt.unwrap_or(DEFAULT_DT);
+        let h = T::lit(dt);
+        if !(dt.is_finite() && dt > 0.0 && h > T::zero() && h.finite()) {
+            return Err(SceneError::new(
+                "--dt",
+                format!("must be a finite step > 0, got {dt}"),
+            ));
+        }
+        let integrator = plan.integrator.unwrap_or(Integrator::SemiImplicitEuler);
+        let broad =
+            stepped_broad_phase(scene, plan.broad).map_err(|e| SceneError::new("--broad", e.0))?;
+        let sign = direction.sign::<T>();
+        let world = &scene.world;
+        let (border, periodic) = match &world.border {
+            Some(b) if b.periodic => (None, Some(b.border)),
+            Some(b) => (Some(b.border), None),
+            None => (None, None),
+        };
+        let periodic_reach = periodic_reach(scene, periodic.as_ref())?;
+        let forces = WorldForces::new(world.gravity, world.drag, direction == Direction::Backward);
+        let stepper = Stepper::new(integrator, forces)
+            .map_err(|e| SceneError::new("--integrator", e.to_string()))?;
+        let rules = Rules::for_scene(scene, h)?;
+        let balls = BallArrays::from_scene(scene, sign)?;
+        let boxes = BoxArrays::new(&scene.boxes, sign);
+        let sweep = Sweep::new(broad, n, periodic.as_ref());
+        let mut engine = Self {
+            balls,
+            boxes,
+            border,
+            periodic,
+            stepper,
+            rules,
+            rest: RestSets::new(n),
+            sweep,
+            queue: BinaryHeap::new(),
+            chunk_events: Vec::new(),
+            chunk_status: Vec::new(),
+            candidates: Vec::new(),
+            touches: [Vec::new(), Vec::new()],
+            clock: Clock {
+                dt,
+                k: 0,
+                s: T::zero(),
+                sign,
+            },
+            counters: Counters::default(),
+            stats: StepStats::default(),
+            pipeline: Vec::new(),
+            event_budget: 1_000_000_u64.max(256 * n as u64),
+            resting_floor: rules.floor,
+            periodic_reach,
+            escape_bound: 64.max(n / 16),
+        };
+        engine.pipeline = engine.describe(scene, integrator);
+        Ok(engine)
+    }
+
+    /// The pipeline names (see [`Simulation::pipeline`]).
+    fn describe(&self, scene: &Scene<T, D>, integrator: Integrator) -> Vec<String> {
+        let mut p = vec![
+            "time-stepped".to_owned(),
+            format!("integrator:{integrator}"),
+            self.sweep.name().to_owned(),
+        ];
+        let n = self.balls.len();
+        if n >= 2 {
+            p.push("narrow:ball-ball".into());
+        }
+        if self.border.is_some() {
+            p.push("narrow:ball-border".into());
+        }
+        if self.periodic.is_some() {
+            p.push("periodic-border".into());
+        }
+        if self.boxes.len() > 0 {
+            p.push("narrow:ball-box".into());
+        }
+        if self.boxes.any_moving() {
+            p.push("kinematic-boxes".into());
+        }
+        p.push("ccd:time-of-impact-sub-steps".into());
+        p.push("response:restitution".into());
+        if scene.world.friction > T::zero() {
+            p.push("response:friction".into());
+        }
+        let surfaces = self.border.is_some() || self.boxes.len() > 0;
+        if surfaces && self.rules.gravity != Vector::<T, D>::zeros() {
+            p.push("guard:resting".into());
+        }
+        if n >= 2 && self.balls.restitution.iter().any(|&e| e < T::one()) {
+            p.push("guard:collapse".into());
+        }
+        for name in self.stepper.field().names() {
+            p.push(format!("field:{name}"));
+        }
+        p
+    }
+
+    /// What the engine did so far beyond the collisions: contacts, resting corrections,
+    /// broad-phase builds, steps that hit the event budget.
+    pub fn stats(&self) -> StepStats {
+        StepStats {
+            broad_builds: self.sweep.builds(),
+            ..self.stats
+        }
+    }
+
+    /// The most contacts one step may process (default: `max(10⁶, 256 N)`).
+    ///
+    /// A step that needs more (a pathological cluster: thousands of balls in a resting
+    /// pile inside a narrow wedge, or a ball trapped between two walls closer than its
+    /// step's travel by a factor above the budget) processes the budget, then **freezes**:
+    /// every ball stays where it is at that moment for the rest of the step, keeping its
+    /// velocity. Freezing never creates an overlap and loses no energy; the step and the
+    /// frozen time are counted in [`StepStats::capped_steps`] and
+    /// [`StepStats::frozen_time`].
+    pub fn set_event_budget(&mut self, budget: u64) {
+        self.event_budget = budget.max(1);
+    }
+
+    /// Sets the velocity of box `k` (world time direction) from now on: the box moves at
+    /// `vel` during the following steps, until the next call. This is how a paddle follows
+    /// a scripted path: before each step (or each `advance_to`), set the velocity that
+    /// brings it where the script wants it at the end of the step. Balls the box hits
+    /// receive its velocity as a kinematic body's (`(1 + e) u` for a ball at rest).
+    ///
+    /// # Errors
+    /// `boxes[k]` if there is no box `k`, `boxes[k].vel[i]` if a component is not finite.
+    pub fn set_box_velocity(&mut self, k: usize, vel: Vector<T, D>) -> Result<(), SceneError> {
+        if k >= self.boxes.len() {
+            return Err(SceneError::new(
+                format!("boxes[{k}]"),
+                format!("no such box: the scene has {}", self.boxes.len()),
+            ));
+        }
+        let vel = ensure_finite_vector("vel", &vel)
+            .map_err(|e| SceneError::from(e.within(&format!("boxes[{k}]"))))?;
+        self.boxes
+            .set_velocity(k, vel * self.clock.sign, self.clock.s);
+        if vel != Vector::<T, D>::zeros() && !self.pipeline.iter().any(|p| p == "kinematic-boxes") {
+            let at = self
+                .pipeline
+                .iter()
+                .position(|p| p.starts_with("ccd:"))
+                .unwrap_or(self.pipeline.len());
+            self.pipeline.insert(at, "kinematic-boxes".into());
+        }
+        Ok(())
+    }
+
+    /// Box `k`'s centre now, or `None` if there is no box `k`.
+    pub fn box_center(&self, k: usize) -> Option<Vector<T, D>> {
+        self.boxes.shape.get(k).map(carom_geometry::Obb::center)
+    }
+
+    /// The step `dt` (s).
+    pub fn dt(&self) -> f64 {
+        self.clock.dt
+    }
+
+    /// The integrator.
+    pub fn integrator(&self) -> Integrator {
+        self.stepper.integrator()
+    }
+
+    fn parallel(&self) -> bool {
+        self.balls.len() >= PARALLEL_MIN && rayon::current_num_threads() > 1
+    }
+
+    /// Integrates every ball over `h` from internal time `t0` and starts the segments.
+    fn integrate(&mut self, h: T, t0: T, parallel: bool) {
+        let Ok(dt) = TimeStep::new(h) else {
+            return;
+        };
+        let b = &mut self.balls;
+        b.seg_x.copy_from_slice(&b.pos);
+        b.seg_v.copy_from_slice(&b.vel);
+        b.seg_w.copy_from_slice(&b.spin);
+        b.seg_t.fill(T::zero());
+        b.supported.fill(false);
+        self.rest.clear();
+        let stepper = &self.stepper;
+        let run = |pos: &mut [Vector<T, D>],
+                   vel: &mut [Vector<T, D>],
+                   spin: &mut [crate::Angular<T, D>],
+                   inverse_mass: &[T],
+                   start: &[Vector<T, D>],
+                   chord: &mut [Vector<T, D>]| {
+            if let Ok(mut bodies) =
+                Bodies::new(pos, vel, inverse_mass).and_then(|bodies| bodies.with_spins(spin))
+            {
+                stepper.step(&mut bodies, t0, dt);
+            }
+            for ((c, p), x) in chord.iter_mut().zip(pos.iter()).zip(start) {
+                *c = (p - x) / h;
+            }
+        };
+        if parallel {
+            b.pos
+                .par_chunks_mut(CHUNK)
+                .zip(b.vel.par_chunks_mut(CHUNK))
+                .zip(b.spin.par_chunks_mut(CHUNK))
+                .zip(b.inverse_mass.par_chunks(CHUNK))
+                .zip(b.seg_x.par_chunks(CHUNK))
+                .zip(b.chord.par_chunks_mut(CHUNK))
+                .for_each(|(((((p, v), w), m), x), c)| run(p, v, w, m, x, c));
+        } else {
+            run(
+                &mut b.pos,
+                &mut b.vel,
+                &mut b.spin,
+                &b.inverse_mass,
+                &b.seg_x,
+                &mut b.chord,
+            );
+        }
+    }
+
+    fn narrow(&self, end: T) -> Narrow<'_, T, D> {
+        Narrow {
+            balls: &self.balls,
+            boxes: &self.boxes,
+            border: self.border.as_ref(),
+            periodic: self.periodic.as_ref(),
+            end,
+            resting_floor: self.resting_floor,
+            gravity: self.rules.gravity,
+            instant: T::lit(self.clock.dt * 1e-6),
+        }
+    }
+
+    /// Predicts every contact of the window `[a, b]` from the broad phase's pairs.
+    fn predict_all(&mut self, a: T, b: T, parallel: bool) -> Result<(), Overflow> {
+        let n = self.balls.len();
+        let pairs = &self.sweep.pairs;
+        let pair_chunks = pairs.len().div_ceil(CHUNK);
+        let ball_chunks = n.div_ceil(CHUNK);
+        let chunks = pair_chunks + ball_chunks;
+        if self.chunk_events.len() < chunks {
+            self.chunk_events.resize_with(chunks, Vec::new);
+        }
+        let narrow = Narrow {
+            balls: &self.balls,
+            boxes: &self.boxes,
+            border: self.border.as_ref(),
+            periodic: self.periodic.as_ref(),
+            end: b,
+            resting_floor: self.resting_floor,
+            gravity: self.rules.gravity,
+            instant: T::lit(self.clock.dt * 1e-6),
+        };
+        let periodic_boxes = self.periodic.is_some() && self.boxes.len() > 0;
+        let nboxes = self.boxes.len();
+        let work = |c: usize, out: &mut Vec<Event<T, D>>| -> Result<(), Overflow> {
+            out.clear();
+            let mut push = |p: Result<Option<Event<T, D>>, Overflow>| -> Result<(), Overflow> {
+                if let Some(e) = p? {
+                    out.push(e);
+                }
+                Ok(())
+            };
+            if c < pair_chunks {
+                let end = ((c + 1) * CHUNK).min(pairs.len());
+                for &(i, j) in &pairs[c * CHUNK..end] {
+                    let (i, j) = (i as usize, j as usize);
+                    if j < n {
+                        push(narrow.ball_ball(i, j, a))?;
+                    } else if i < n {
+                        push(narrow.ball_box(i, j - n, a))?;
+                    }
+                }
+            } else {
+                let c = c - pair_chunks;
+                for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                    push(narrow.ball_border(i, a))?;
+                    if periodic_boxes {
+                        for k in 0..nboxes {
+                            push(narrow.ball_box(i, k, a))?;
+                        }
+                    }
+                }
+            }
+            Ok(())
+        };
+        self.chunk_status.resize(self.chunk_events.len(), Ok(()));
+        let (buffers, status) = (
+            &mut self.chunk_events[..chunks],
+            &mut self.chunk_status[..chunks],
+        );
+        if parallel {
+            buffers
+                .par_iter_mut()
+                .zip(status.par_iter_mut())
+                .enumerate()
+                .for_each(|(c, (out, status))| *status = work(c, out));
+        } else {
+            for (c, (out, status)) in buffers.iter_mut().zip(status.iter_mut()).enumerate() {
+                *status = work(c, out);
+            }
+        }
+        // The first failing chunk in chunk order: the same error on any thread count.
+        self.chunk_status[..chunks]
+            .iter()
+            .copied()
+            .collect::<Result<(), Overflow>>()?;
+        for events in &self.chunk_events[..chunks] {
+            self.queue.extend(events.iter().map(|&e| Pending(e)));
+        }
+        Ok(())
+    }
+
+    /// Predicts the contacts of ball `i` after `s` within the window ending at `end`,
+    /// skipping partners in `skip` (already predicted against `i`).
+    fn predict_ball(&mut self, i: usize, s: T, end: T, skip: &[u32]) -> Result<(), Overflow> {
+        let n = self.balls.len();
+        let x = self.balls.position_at(i, s);
+        let path = path_box(&x, &self.balls.pos[i], self.balls.radius[i]);
+        let mut candidates = core::mem::take(&mut self.candidates);
+        self.sweep.candidates(&path, &mut candidates);
+        candidates.sort_unstable();
+        candidates.dedup();
+        let narrow = self.narrow(end);
+        let mut found = Vec::new();
+        let mut result = Ok(());
+        for &c in &candidates {
+            let c = c as usize;
+            let p = if c < n {
+                if c == i || skip.contains(&(c as u32)) {
+                    continue;
+                }
+                narrow.ball_ball(i.min(c), i.max(c), s)
+            } else if self.sweep.boxes_inside() {
+                narrow.ball_box(i, c - n, s)
+            } else {
+                continue;
+            };
+            match p {
+                Ok(Some(e)) => found.push(e),
+                Ok(None) => {}
+                Err(e) => result = result.and(Err(e)),
+            }
+        }
+        if self.periodic.is_some() {
+            for k in 0..self.boxes.len() {
+                match narrow.ball_box(i, k, s) {
+                    Ok(Some(e)) => found.push(e),
+                    Ok(None) => {}
+                    Err(e) => result = result.and(Err(e)),
+                }
+            }
+        }
+        match narrow.ball_border(i, s) {
+            Ok(Some(e)) => found.push(e),
+            Ok(None) => {}
+            Err(e) => result = result.and(Err(e)),
+        }
+        self.queue.extend(found.into_iter().map(Pending));
+        self.candidates = candidates;
+        result
+    }
+
+    /// Whether the event's balls are unchanged since it was predicted.
+    fn current(&self, e: &Event<T, D>) -> bool {
+        let v = &self.balls.version;
+        v[e.ball as usize] == e.versions[0]
+            && match e.target {
+                Target::Ball(j) => v[j as usize] == e.versions[1],
+                Target::Border | Target::Box(_) => true,
+            }
+    }
+
+    /// Processes one event; returns the balls it changed (1 or 2) and the collision to
+    /// report, if any.
+    fn process(&mut self, e: &Event<T, D>, h: T, t0: T) -> ([u32; 2], usize, Option<Collision<T>>) {
+        let i = e.ball as usize;
+        let other = match e.target {
+            Target::Ball(j) => j as usize,
+            Target::Border | Target::Box(_) => i,
+        };
+        let mut touches = core::mem::take(&mut self.touches);
+        for (ball, out) in [i, other].into_iter().zip(touches.iter_mut()) {
+            out.clear();
+            if self.rules.gravity != Vector::<T, D>::zeros() {
+                self.gather(ball, e.time, out);
+            }
+        }
+        let mut contacts = Contacts {
+            balls: &mut self.balls,
+            boxes: &self.boxes,
+            stepper: &self.stepper,
+            rules: &self.rules,
+            rest: &mut self.rest,
+            touching: [(i, &touches[0]), (other, &touches[1])],
+            h,
+            t0,
+        };
+        let time = (t0 + e.time) * self.clock.sign + T::zero();
+        let (effect, changed, count, collision): (Effect, [u32; 2], usize, Collision<T>) =
+            match e.target {
+                Target::Ball(j) => (
+                    contacts.ball_ball(i, j as usize, &e.shift, e.time, &e.normal),
+                    [e.ball, j],
+                    2,
+                    Collision::BallBall {
+                        time,
+                        i,
+                        j: j as usize,
+                    },
+                ),
+                Target::Border => (
+                    contacts.ball_surface(i, Surface::Wall, &e.normal, e.time),
+                    [e.ball, e.ball],
+                    1,
+                    Collision::BallBorder { time, i },
+                ),
+                Target::Box(k) => {
+                    let k = k as usize;
+                    let v = self.boxes.vel[k];
+                    (
+                        contacts.ball_surface(i, Surface::Box(k, v), &e.normal, e.time),
+                        [e.ball, e.ball],
+                        1,
+                        Collision::BallBox { time, i, k },
+                    )
+                }
+            };
+        self.touches = touches;
+        self.stats.contacts += 1;
+        if !effect.collided {
+            self.stats.resting += 1;
+        }
+        let report = effect.collided.then(|| {
+            match collision {
+                Collision::BallBall { .. } => self.counters.ball_ball += 1,
+                Collision::BallBorder { .. } => self.counters.ball_border += 1,
+                Collision::BallBox { .. } => self.counters.ball_box += 1,
+            }
+            collision
+        });
+        (changed, count, report)
+    }
+
+    /// The supports ball `i` touches at in-step time `s` (within `1e-9` of its radius):
+    /// walls of the border, boxes, and balls below it (along gravity) that do not move
+    /// up into it.
+    fn gather(&mut self, i: usize, s: T, out: &mut Vec<Touch<T, D>>) {
+        let b = &self.balls;
+        let (x, r) = (b.position_at(i, s), b.radius[i]);
+        let tolerance = T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (x.amax() + r);
+        if let Some(border) = &self.border {
+            for axis in 0..D {
+                for (upper, gap) in [
+                    (false, x[axis] - r - border.min()[axis]),
+                    (true, border.max()[axis] - x[axis] - r),
+                ] {
+                    if gap <= tolerance {
+                        let mut normal = Vector::zeros();
+                        normal[axis] = if upper { T::one() } else { -T::one() };
+                        out.push(Touch {
+                            support: Support::Wall(axis, upper),
+                            normal,
+                            velocity: Vector::zeros(),
+                        });
+                    }
+                }
+            }
+        }
+        let n = b.len();
+        let path = path_box(&x, &b.pos[i], r + tolerance);
+        let mut candidates = core::mem::take(&mut self.candidates);
+        self.sweep.candidates(&path, &mut candidates);
+        let g = self.rules.gravity;
+        let boxes = if self.sweep.boxes_inside() {
+            None
+        } else {
+            Some(0..self.boxes.len())
+        };
+        let box_ids = candidates
+            .iter()
+            .filter(|&&c| c as usize >= n)
+            .map(|&c| c as usize - n)
+            .chain(boxes.into_iter().flatten());
+        for k in box_ids {
+            let obb = self.boxes.at(k, s);
+            let shift = self.periodic.map_or_else(Vector::zeros, |p| {
+                p.minimum_image(&(obb.center() - x)) - (obb.center() - x)
+            });
+            let local = obb.to_local(&(x - shift));
+            let q = obb.to_world(&local.inf(&obb.half_extents()).sup(&-obb.half_extents())) + shift;
+            let d = (q - x).norm();
+            if d > T::zero() && d - r <= tolerance {
+                out.push(Touch {
+                    support: Support::Box(k as u32),
+                    normal: (q - x) / d,
+                    velocity: self.boxes.vel[k],
+                });
+            }
+        }
+        for &c in candidates.iter().filter(|&&c| (c as usize) < n) {
+            let j = c as usize;
+            if j == i {
+                continue;
+            }
+            let y = b.position_at(j, s);
+            let y = self.periodic.map_or(y, |p| x + p.minimum_image(&(y - x)));
+            let d = (y - x).norm();
+            if !(d > T::zero() && d - r - b.radius[j] <= tolerance) {
+                continue;
+            }
+            let normal = (y - x) / d;
+            // Below the ball, and not moving up into it (within rounding): it can hold it.
+            if g.dot(&normal) > T::zero() && b.chord[j].dot(&normal) >= -self.rules.floor {
+                out.push(Touch {
+                    support: Support::Ball(j as u32),
+                    normal,
+                    velocity: b.chord[j],
+                });
+            }
+        }
+        self.candidates = candidates;
+    }
+
+    /// Stops every ball at in-step time `s` for the rest of the step (velocities kept).
+    fn freeze(&mut self, s: T, h: T) {
+        let b = &mut self.balls;
+        for i in 0..b.len() {
+            b.restart(i, s, h);
+            let (x, v, w) = (b.seg_x[i], b.seg_v[i], b.seg_w[i]);
+            b.chord[i] = Vector::zeros();
+            b.pos[i] = x;
+            b.vel[i] = v;
+            b.spin[i] = w;
+        }
+        self.stats.capped_steps += 1;
+        self.stats.frozen_time += (h - s).to_f64();
+    }
+
+    /// Runs the events of the window `[a, b]` of a step of length `h` starting at
+    /// internal time `t0`.
+    fn run_window(
+        &mut self,
+        b: T,
+        h: T,
+        t0: T,
+        step_contacts: &mut u64,
+        observer: &mut dyn Observer<T>,
+    ) -> Result<WindowEnd<T>, SimError> {
+        while let Some(Pending(e)) = self.queue.pop() {
+            if !self.current(&e) {
+                continue;
+            }
+            if *step_contacts >= self.event_budget {
+                self.queue.clear();
+                return Ok(WindowEnd::Budget(e.time));
+            }
+            *step_contacts += 1;
+            let (changed, count, report) = self.process(&e, h, t0);
+            if let Some(c) = report {
+                observer.collision(&c);
+            }
+            let mut cut = false;
+            for &c in &changed[..count] {
+                let c = c as usize;
+                self.balls.version[c] = self.balls.version[c].wrapping_add(1);
+                let path = path_box(
+                    &self.balls.seg_x[c],
+                    &self.balls.pos[c],
+                    self.balls.radius[c],
+                );
+                cut |= self.sweep.moved(c, path) > self.escape_bound;
+                cut |= self.balls.chord[c].norm() * (b - e.time) > self.periodic_reach;
+            }
+            if cut {
+                self.queue.clear();
+                self.stats.rebuilds += 1;
+                return Ok(WindowEnd::Cut(e.time));
+            }
+            for (k, &c) in changed[..count].iter().enumerate() {
+                self.predict_ball(c as usize, e.time, b, &changed[..k])
+                    .map_err(|o| self.overflow(o, t0 + e.time))?;
+            }
+        }
+        Ok(WindowEnd::Done)
+    }
+
+    fn overflow(&self, o: Overflow, s: T) -> SimError {
+        SimError {
+            time: (s * self.clock.sign).to_f64(),
+            message: format!(
+                "a time of impact of ball {} overflowed this precision (coordinates or speeds too large)",
+                o.ball
+            ),
+        }
+    }
+
+    /// The end of the window starting at `a` in a step of length `h`: the step's end, or
+    /// earlier in a periodic domain so that no ball moves more than `periodic_reach`.
+    fn window_end(&self, a: T, h: T) -> T {
+        if self.periodic.is_none() {
+            return h;
+        }
+        let fastest = self
+            .balls
+            .chord
+            .iter()
+            .fold(T::zero(), |m, u| m.max(u.norm()));
+        if fastest * (h - a) <= self.periodic_reach {
+            h
+        } else {
+            (a + self.periodic_reach / fastest).min(h)
+        }
+    }
+
+    /// Wraps every ball's segment into the periodic cell at in-step time `s`.
+    fn wrap(&mut self, s: T, h: T) {
+        let Some(border) = self.periodic else {
+            return;
+        };
+        let b = &mut self.balls;
+        for i in 0..b.len() {
+            let x = b.position_at(i, s);
+            let shift = border.wrap(&x) - x;
+            if shift != Vector::<T, D>::zeros() {
+                b.restart(i, s, h);
+                b.seg_x[i] += shift;
+                b.pos[i] += shift;
+            }
+        }
+    }
+
+    /// One step of length `h` from the current time.
+    fn step(&mut self, h: T, observer: &mut dyn Observer<T>) -> Result<(), SimError> {
+        let t0 = self.clock.s;
+        let parallel = self.parallel();
+        self.integrate(h, t0, parallel);
+        let mut a = T::zero();
+        let mut step_contacts = 0;
+        let mut first = self.periodic.is_none();
+        while a < h {
+            let b = self.window_end(a, h);
+            if first {
+                let escapees = self
+                    .sweep
+                    .begin_step(&self.balls, &self.boxes, h, self.escape_bound, parallel)
+                    .len();
+                self.predict_all(a, b, parallel)
+                    .map_err(|o| self.overflow(o, t0 + a))?;
+                for k in 0..escapees {
+                    let e = self.sweep.escapee(k);
+                    self.predict_ball(e, a, b, &[])
+                        .map_err(|o| self.overflow(o, t0 + a))?;
+                }
+            } else {
+                let reach = if self.periodic.is_some() {
+                    b - a
+                } else {
+                    (h - a) + h * T::from_count(REACH_STEPS as usize - 1)
+                };
+                self.sweep
+                    .build(&self.balls, &self.boxes, a, reach, parallel);
+                self.predict_all(a, b, parallel)
+                    .map_err(|o| self.overflow(o, t0 + a))?;
+            }
+            first = false;
+            a = match self.run_window(b, h, t0, &mut step_contacts, observer)? {
+                WindowEnd::Done => b,
+                WindowEnd::Cut(s) => s,
+                WindowEnd::Budget(s) => {
+                    self.freeze(s, h);
+                    h
+                }
+            };
+            self.wrap(a, h);
+        }
+        self.stats.steps += 1;
+        self.stats.max_contacts_in_step = self.stats.max_contacts_in_step.max(step_contacts);
+        Ok(())
+    }
+}
+
+/// The farthest a ball may move within one window of a periodic domain, so that the
+/// minimum image is the only image of another ball it can reach: a quarter of what half
+/// the narrowest period leaves after two diameters (infinite without a periodic border).
+///
+/// # Errors
+/// `world.border` if two ball diameters do not fit in half the narrowest period.
+fn periodic_reach<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    periodic: Option<&Border<T, D>>,
+) -> Result<T, SceneError> {
+    let Some(p) = periodic else {
+        return Ok(T::INFINITY);
+    };
+    let r_max = scene.balls.iter().fold(T::zero(), |m, b| m.max(b.radius));
+    let half = p.extents().min() * T::lit(0.5);
+    if T::lit(2.0) * r_max >= half {
+        return Err(SceneError::new(
+            "world.border",
+            format!(
+                "a periodic border must be wider than 4 ball radii on every axis (the largest radius is {r_max}, the narrowest period {})",
+                p.extents().min()
+            ),
+        ));
+    }
+    Ok((half - T::lit(2.0) * r_max) * T::lit(0.25))
+}
+
+impl<T: Real, const D: usize> Simulation<T, D> for SteppedEngine<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    fn kind(&self) -> EngineKind {
+        EngineKind::Stepped
+    }
+
+    fn pipeline(&self) -> Vec<String> {
+        self.pipeline.clone()
+    }
+
+    fn time(&self) -> T {
+        self.clock.s * self.clock.sign + T::zero()
+    }
+
+    fn advance_to(&mut self, target: T, observer: &mut dyn Observer<T>) -> Result<(), SimError> {
+        let sign = self.clock.sign;
+        let goal = target * sign;
+        let h = T::lit(self.clock.dt);
+        let tolerance = (T::lit(1e-9) * h).max(T::lit(64.0) * T::EPSILON * goal.abs());
+        if !goal.finite() || goal < self.clock.s - tolerance {
+            return Err(SimError {
+                time: self.time().to_f64(),
+                message: format!(
+                    "cannot advance to {target}: the run is at {} and goes {}",
+                    self.time(),
+                    if sign > T::zero() {
+                        "forward"
+                    } else {
+                        "backward"
+                    }
+                ),
+            });
+        }
+        while goal - self.clock.s > tolerance {
+            let next = self.clock.grid(self.clock.k + 1);
+            let (len, on_grid) = if next <= goal + tolerance {
+                (next - self.clock.s, true)
+            } else {
+                (goal - self.clock.s, false)
+            };
+            self.step(len, observer)?;
+            if on_grid {
+                self.clock.k += 1;
+                self.clock.s = next;
+            } else {
+                self.clock.s = goal;
+            }
+            self.boxes.advance(self.clock.s, self.periodic.as_ref());
+            if self.stats.steps.is_multiple_of(PROGRESS_EVERY) {
+                observer.progress(self.time());
+            }
+        }
+        Ok(())
+    }
+
+    fn states(&self, out: &mut BallStates<T, D>) {
+        let sign = self.clock.sign;
+        out.reset(self.balls.len());
+        out.pos.extend_from_slice(&self.balls.pos);
+        out.vel.extend(self.balls.vel.iter().map(|v| v * sign));
+        out.spin.extend(self.balls.spin.iter().map(|w| *w * sign));
+    }
+
+    fn counters(&self) -> Counters {
+        self.counters
+    }
+}

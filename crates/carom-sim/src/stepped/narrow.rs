@@ -1,0 +1,304 @@
+//! The narrow phase of a step: exact times of impact along the balls' chords, and the
+//! queue of pending contacts.
+//!
+//! Within a window every ball moves on a straight segment (see `balls`), so each pair's
+//! first contact is carom-toi's closed form for linear relative motion: [`ball_ball`],
+//! [`ball_border`] for the walls of a reflecting border, [`ball_obb`] for a box
+//! translating at its own velocity. Times are offsets from the time `s` the prediction
+//! is made at, within the horizon `end − s`; the event records the in-step time.
+//!
+//! A contact whose normal approach speed at the time of contact is at the level of
+//! rounding (`64 ε` times the two speeds) is not an event: it comes from a pair left
+//! touching with zero relative normal velocity by a previous response, and acting on it
+//! would only repeat that response. Contacts approaching slower than the engine's
+//! resting floor (a millionth of what gravity adds in one step, plus `64 ε` times the
+//! scene's speed scale) are not events either: they are the rounding residue of resting
+//! corrections, which would otherwise be corrected again and again without change; the
+//! overlap one can leave is at most that speed times the step, and is acted on at the
+//! next step if it grows.
+//!
+//! In a periodic domain a ball meets the minimum image of another ball (the window is
+//! short enough for it to be the only one that can be reached), and every image of a
+//! box whose swept box the ball's path reaches.
+//!
+//! [`ball_ball`]: carom_toi::ball_ball
+//! [`ball_border`]: carom_toi::ball_border
+//! [`ball_obb`]: carom_toi::ball_obb
+
+use core::cmp::Ordering;
+
+use carom_geometry::{Ball, Border};
+use carom_math::{Real, Space, Vector};
+use carom_toi::{Kinematics, Status, Toi, Window, ball_ball, ball_border, ball_obb};
+use nalgebra::Const;
+
+use super::balls::BallArrays;
+use super::obstacles::{BoxArrays, image_offsets};
+use super::sweep::{overlap, path_box};
+
+/// What a ball touches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum Target {
+    /// Another ball (with a higher index).
+    Ball(u32),
+    /// A wall of the reflecting border.
+    Border,
+    /// A box.
+    Box(u32),
+}
+
+/// A predicted contact.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Event<T: Real, const D: usize> {
+    /// The instant: the contact time in units of the simultaneity window (see
+    /// [`Event::key_cmp`]).
+    instant: u64,
+    /// The height of the lower body at contact, along gravity (zero without gravity).
+    height: T,
+    /// In-step time of the contact.
+    pub(crate) time: T,
+    /// The ball (the lower index for two balls).
+    pub(crate) ball: u32,
+    /// What it touches.
+    pub(crate) target: Target,
+    /// The versions of the ball and (for two balls) the other ball at prediction.
+    pub(crate) versions: [u32; 2],
+    /// The unit normal at contact, from the ball to the target.
+    pub(crate) normal: Vector<T, D>,
+    /// The periodic shift of the target (zero in open space).
+    pub(crate) shift: Vector<T, D>,
+}
+
+impl<T: Real, const D: usize> Event<T, D> {
+    /// The total order the queue pops in: the instant, then bottom-up along gravity, then
+    /// the time, the pair and the versions. Contacts within one simultaneity window (a
+    /// millionth of the step) are one instant: a pile of balls touching within rounding
+    /// is settled from the floor up, so that every ball finds its supports already at
+    /// rest. Equal keys are the same prediction, so the order never depends on how
+    /// events were inserted (thread count, chunking).
+    fn key_cmp(&self, other: &Self) -> Ordering {
+        let cmp = |a: T, b: T| a.partial_cmp(&b).unwrap_or(Ordering::Equal);
+        self.instant
+            .cmp(&other.instant)
+            .then(cmp(self.height, other.height))
+            .then(cmp(self.time, other.time))
+            .then(self.ball.cmp(&other.ball))
+            .then(self.target.cmp(&other.target))
+            .then(self.versions.cmp(&other.versions))
+    }
+}
+
+/// A min-queue entry.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Pending<T: Real, const D: usize>(pub(crate) Event<T, D>);
+
+impl<T: Real, const D: usize> PartialEq for Pending<T, D> {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.key_cmp(&other.0) == Ordering::Equal
+    }
+}
+impl<T: Real, const D: usize> Eq for Pending<T, D> {}
+impl<T: Real, const D: usize> PartialOrd for Pending<T, D> {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl<T: Real, const D: usize> Ord for Pending<T, D> {
+    /// Reversed: `BinaryHeap` is a max-heap, the earliest event must come first.
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.0.key_cmp(&self.0)
+    }
+}
+
+/// Why a prediction could not be made: a time of impact overflowed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Overflow {
+    /// The ball.
+    pub(crate) ball: u32,
+}
+
+/// What predictions read: the balls, the obstacles, the window end and the thresholds.
+pub(crate) struct Narrow<'a, T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    pub(crate) balls: &'a BallArrays<T, D>,
+    pub(crate) boxes: &'a BoxArrays<T, D>,
+    /// The reflecting border, if any.
+    pub(crate) border: Option<&'a Border<T, D>>,
+    /// The periodic domain, if any.
+    pub(crate) periodic: Option<&'a Border<T, D>>,
+    /// The end of the current window (in-step time).
+    pub(crate) end: T,
+    /// Contacts approaching slower than this are not events.
+    pub(crate) resting_floor: T,
+    /// Gravity (for the bottom-up order of simultaneous contacts).
+    pub(crate) gravity: Vector<T, D>,
+    /// The simultaneity window (in-step time).
+    pub(crate) instant: T,
+}
+
+type Prediction<T, const D: usize> = Result<Option<Event<T, D>>, Overflow>;
+
+impl<T: Real, const D: usize> Narrow<'_, T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    fn window(&self, s: T) -> Window<T> {
+        Window::forward((self.end - s).max(T::zero())).unwrap_or_else(|_| {
+            Window::forward(T::zero()).unwrap_or(Window::unbounded(carom_toi::Direction::Forward))
+        })
+    }
+
+    fn kinematics(&self, i: usize) -> Kinematics<T, D> {
+        Kinematics::new_unchecked(self.balls.chord[i], Vector::zeros())
+    }
+
+    /// Turns a time of impact into an event, or `None` if it is no contact worth acting on.
+    #[allow(clippy::too_many_arguments)]
+    fn event<F>(
+        &self,
+        toi: &Toi<T, D, F>,
+        s: T,
+        ball: usize,
+        target: Target,
+        other_velocity: &Vector<T, D>,
+        versions: [u32; 2],
+        shift: Vector<T, D>,
+    ) -> Prediction<T, D> {
+        match toi.status {
+            Status::Hit | Status::AlreadyTouching => {}
+            Status::NoHit => return Ok(None),
+            Status::NotConverged => return Err(Overflow { ball: ball as u32 }),
+        }
+        let u = &self.balls.chord[ball];
+        let approach = (u - other_velocity).dot(&toi.normal);
+        let rounding = T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm());
+        if approach <= rounding || approach <= self.resting_floor {
+            return Ok(None);
+        }
+        let time = (s + toi.time).min(self.end);
+        let x = self.balls.position_at(ball, time);
+        let height = match target {
+            Target::Ball(j) => {
+                let y = self.balls.position_at(j as usize, time) + shift;
+                -self.gravity.dot(&x).max(self.gravity.dot(&y))
+            }
+            Target::Border | Target::Box(_) => -self.gravity.dot(&x),
+        };
+        Ok(Some(Event {
+            instant: (time / self.instant).floor().to_f64() as u64,
+            height,
+            time,
+            ball: ball as u32,
+            target,
+            versions,
+            normal: toi.normal,
+            shift,
+        }))
+    }
+
+    /// The first contact of balls `i < j` after `s`.
+    pub(crate) fn ball_ball(&self, i: usize, j: usize, s: T) -> Prediction<T, D> {
+        let b = self.balls;
+        let (pi, pj) = (b.position_at(i, s), b.position_at(j, s));
+        let shift = match self.periodic {
+            Some(p) => (pi + p.minimum_image(&(pj - pi))) - pj,
+            None => Vector::zeros(),
+        };
+        let toi = ball_ball(
+            &Ball::new_unchecked(pi, b.radius[i]),
+            &self.kinematics(i),
+            &Ball::new_unchecked(pj + shift, b.radius[j]),
+            &self.kinematics(j),
+            &self.window(s),
+        );
+        self.event(
+            &toi,
+            s,
+            i,
+            Target::Ball(j as u32),
+            &b.chord[j],
+            [b.version[i], b.version[j]],
+            shift,
+        )
+    }
+
+    /// The first wall of the reflecting border ball `i` touches after `s`.
+    pub(crate) fn ball_border(&self, i: usize, s: T) -> Prediction<T, D> {
+        let Some(border) = self.border else {
+            return Ok(None);
+        };
+        let b = self.balls;
+        let x = b.position_at(i, s);
+        let r = b.radius[i];
+        let y = x + b.chord[i] * (self.end - s);
+        // Clear of every wall by more than rounding along the whole segment: no contact.
+        let margin = r + T::lit(8.0) * T::EPSILON * (x.amax() + y.amax() + r);
+        let (lo, hi) = (border.min(), border.max());
+        if (0..D).all(|k| lo[k] + margin < x[k].min(y[k]) && x[k].max(y[k]) + margin < hi[k]) {
+            return Ok(None);
+        }
+        let toi = ball_border(
+            &Ball::new_unchecked(x, r),
+            &self.kinematics(i),
+            border,
+            &self.window(s),
+        );
+        self.event(
+            &toi,
+            s,
+            i,
+            Target::Border,
+            &Vector::zeros(),
+            [b.version[i], 0],
+            Vector::zeros(),
+        )
+    }
+
+    /// The first contact of ball `i` with box `k` (or, in a periodic domain, any of its
+    /// images) after `s`.
+    pub(crate) fn ball_box(&self, i: usize, k: usize, s: T) -> Prediction<T, D> {
+        let b = self.balls;
+        let x = b.position_at(i, s);
+        let r = b.radius[i];
+        let ball = Ball::new_unchecked(x, r);
+        let path = path_box(&x, &(x + b.chord[i] * (self.end - s)), r);
+        let obb = self.boxes.at(k, s);
+        let box_motion = Kinematics::new_unchecked(self.boxes.vel[k], Vector::zeros());
+        let swept = self.boxes.swept(k, s, self.end);
+        let window = self.window(s);
+        let mut best: Prediction<T, D> = Ok(None);
+        let mut try_image = |shift: Vector<T, D>| {
+            if !overlap(&swept.translated(&shift), &path) {
+                return;
+            }
+            let toi = ball_obb(
+                &ball,
+                &self.kinematics(i),
+                &obb.translated(&shift),
+                &box_motion,
+                &window,
+            );
+            let found = self.event(
+                &toi,
+                s,
+                i,
+                Target::Box(k as u32),
+                &self.boxes.vel[k],
+                [b.version[i], 0],
+                shift,
+            );
+            best = match (best, found) {
+                (Err(e), _) | (_, Err(e)) => Err(e),
+                (Ok(Some(a)), Ok(Some(c))) => Ok(Some(if c.time < a.time { c } else { a })),
+                (Ok(a), Ok(c)) => Ok(a.or(c)),
+            };
+        };
+        match self.periodic {
+            None => try_image(Vector::zeros()),
+            Some(border) => image_offsets(border).for_each(try_image),
+        }
+        best
+    }
+}

@@ -1,0 +1,446 @@
+//! What a contact does to the balls within a step: one physical impulse, the rest of the
+//! step re-integrated, and, if the new paths still close on each other, a correction of
+//! the paths (a resting contact).
+//!
+//! At a contact at in-step time `s` (see `docs/stepped.md` for the whole argument):
+//!
+//! 1. Each ball's segment is restarted at `s` (position on its chord, physical velocity
+//!    and spin interpolated).
+//! 2. **Collision.** carom-response's [`resolve`] acts on the physical velocities with the
+//!    pair's restitution and the world's friction, after the guards:
+//!    * ball–wall and ball–box: the [`RestingGuard`] with a minimum flight time of two
+//!      steps — a bounce too small to fly for two steps under the normal component of
+//!      gravity ends in rest (`e = 0`), which stops Zeno bouncing;
+//!    * ball–ball: the [`CollapseGuard`] `ElasticBelow`: collisions approaching slower than
+//!      what gravity adds in one step (or a millionth of the scene's speed scale without
+//!      gravity) are elastic, which ends inelastic collapse within a step.
+//!
+//!    If an impulse was applied, each dynamic ball's remaining step `[s, h]` is
+//!    re-integrated from its new velocity with the engine's integrator, so forces act on
+//!    the motion after the collision (bounce heights keep the integrator's order).
+//! 3. **Resting contact.** If the pair's chords still close on each other (gravity pulls a
+//!    ball back into the floor within the rest of the step; a ball rests on another that
+//!    rests on the floor), the chords get a second impulse, computed on the chord
+//!    velocities, that stops them closing: restitution 0 against a wall or a box (the
+//!    ball stays on it and slides or rolls, friction included) and 1 between two balls
+//!    (the approach passes down a stack to whatever supports it, exactly as an elastic
+//!    chain passes momentum: a column of `k` balls settles in `k(k+1)/2` contacts, where
+//!    restitution 0 would only converge geometrically). The same change is applied to
+//!    the physical velocity over the segment, whose component along the normal becomes
+//!    the chord's: a ball held on a surface does not end the step moving into it (with
+//!    Verlet, RK4 or the exact integrator the end velocity would otherwise keep half a
+//!    step of gravity). The energy cost is at most the kinetic energy of the normal
+//!    velocity, `½ m (g h)²` per resting ball per step; the ball's velocity does not
+//!    grow step after step.
+//!
+//! After these, the pair no longer closes along its chords, so the same contact is not
+//! found again; the event loop goes on with the next one.
+
+use carom_integrate::{ForceField, Stepper, TimeStep};
+use carom_math::{Real, Space, Vector};
+use carom_response::guard::{Bounce, CollapseGuard, RestingGuard};
+use carom_response::{Body, Coefficients, Contact, normal_velocity, resolve};
+use nalgebra::Const;
+
+use super::balls::BallArrays;
+use super::obstacles::BoxArrays;
+use super::rest::{RestSet, Support, Touch};
+use crate::engine::Angular;
+use crate::scene::{Scene, SceneError};
+
+/// The rules of a scene's contacts.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rules<T: Real, const D: usize> {
+    /// Coulomb coefficient of every ball contact.
+    pub(crate) friction: T,
+    /// Ball–wall restitution of the reflecting border.
+    pub(crate) border_restitution: T,
+    /// Gravity (the acceleration the resting guard projects on the normal).
+    pub(crate) gravity: Vector<T, D>,
+    /// The Zeno guard of ball–surface bounces.
+    pub(crate) resting: RestingGuard<T>,
+    /// The inelastic-collapse guard of ball–ball collisions.
+    pub(crate) collapse: CollapseGuard<T>,
+    /// `|g| h`: an impulse approaching no faster than gravity adds in one step is support
+    /// of a resting contact, not a collision to report.
+    pub(crate) support_speed: T,
+    /// Speeds below this are rounding or residue of resting corrections: a millionth of
+    /// what gravity adds in a step plus `64 ε` times the scene's speed scale (the fastest
+    /// ball or box at the start).
+    pub(crate) floor: T,
+}
+
+impl<T: Real, const D: usize> Rules<T, D> {
+    /// The rules of `scene` stepped at `h`: the scene's friction and border restitution,
+    /// the resting guard with a minimum flight of two steps, the collapse guard elastic
+    /// below what gravity adds in a step (at least a millionth of the fastest ball or box
+    /// of the scene).
+    ///
+    /// # Errors
+    /// `--dt` if the guards' parameters are not representable (a step near the limits
+    /// of the precision).
+    pub(crate) fn for_scene(scene: &Scene<T, D>, h: T) -> Result<Self, SceneError> {
+        let world = &scene.world;
+        let g = world.gravity.norm();
+        let speed = scene
+            .balls
+            .iter()
+            .map(|b| b.vel.norm())
+            .chain(scene.boxes.iter().map(|b| b.vel.norm()))
+            .fold(g * h, T::max);
+        let collapse_speed = (g * h).max(T::lit(1e-6) * speed).max(T::MIN_POSITIVE);
+        let bad_step = |e: carom_math::InvalidValue| SceneError::new("--dt", e.to_string());
+        Ok(Self {
+            friction: world.friction,
+            border_restitution: world.border.as_ref().map_or_else(T::one, |b| b.restitution),
+            gravity: world.gravity,
+            resting: RestingGuard::new(T::lit(2.0) * h).map_err(bad_step)?,
+            collapse: CollapseGuard::elastic_below(collapse_speed).map_err(bad_step)?,
+            support_speed: T::lit(2.0) * g * h,
+            floor: T::lit(1e-6) * g * h + T::lit(64.0) * T::EPSILON * speed,
+        })
+    }
+}
+
+/// What a processed contact did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Effect {
+    /// An impulse faster than support was applied: a collision to report.
+    pub(crate) collided: bool,
+}
+
+/// The other side of a ball's contact.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Surface<T: Real, const D: usize> {
+    /// A wall of the border.
+    Wall,
+    /// Box `k`, moving at its velocity.
+    Box(usize, Vector<T, D>),
+}
+
+/// The support constraints of the balls held at the current instant, sparse.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct RestSets<T: Real, const D: usize> {
+    /// Per ball: its entry in `sets`, or `u32::MAX`.
+    slot: Vec<u32>,
+    sets: Vec<(u32, RestSet<T, D>)>,
+}
+
+impl<T: Real, const D: usize> RestSets<T, D> {
+    /// Empty sets for `n` balls.
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            slot: vec![u32::MAX; n],
+            sets: Vec::new(),
+        }
+    }
+
+    /// Forgets every set (at the start of a step).
+    pub(crate) fn clear(&mut self) {
+        for (ball, _) in &self.sets {
+            self.slot[*ball as usize] = u32::MAX;
+        }
+        self.sets.clear();
+    }
+
+    /// Ball `i`'s set for the instant `s`, started afresh from `chord` if it was for
+    /// another instant (or `fresh` asks for it: the chord changed by other means).
+    fn at(
+        &mut self,
+        i: usize,
+        s: T,
+        tolerance: T,
+        chord: Vector<T, D>,
+        fresh: bool,
+    ) -> &mut RestSet<T, D> {
+        let k = match self.slot[i] {
+            u32::MAX => {
+                self.slot[i] = self.sets.len() as u32;
+                self.sets.push((i as u32, RestSet::new(s, chord)));
+                self.sets.len() - 1
+            }
+            k => k as usize,
+        };
+        let set = &mut self.sets[k].1;
+        if fresh || !set.is_at(s, tolerance) {
+            *set = RestSet::new(s, chord);
+        }
+        set
+    }
+
+    /// Ball `i`'s chord changed other than by a resting correction at `s`.
+    fn restart(&mut self, i: usize, s: T, chord: Vector<T, D>) {
+        if self.slot[i] != u32::MAX {
+            self.at(i, s, T::zero(), chord, true);
+        }
+    }
+}
+
+/// The balls, the integrator and the rules, for processing contacts.
+pub(crate) struct Contacts<'a, T: Real, const D: usize, F>
+where
+    Const<D>: Space<T, D>,
+{
+    pub(crate) balls: &'a mut BallArrays<T, D>,
+    pub(crate) boxes: &'a BoxArrays<T, D>,
+    pub(crate) stepper: &'a Stepper<T, D, F>,
+    pub(crate) rules: &'a Rules<T, D>,
+    pub(crate) rest: &'a mut RestSets<T, D>,
+    /// The supports the contact's balls touch now: `(ball, touches)` (gathered only
+    /// under gravity; see `rest_on`).
+    pub(crate) touching: [(usize, &'a [Touch<T, D>]); 2],
+    /// The step's length.
+    pub(crate) h: T,
+    /// The internal time of the step's start (for time-dependent fields).
+    pub(crate) t0: T,
+}
+
+impl<T: Real, const D: usize, F: ForceField<T, D>> Contacts<'_, T, D, F>
+where
+    Const<D>: Space<T, D>,
+{
+    fn body(&self, i: usize, v: Vector<T, D>, w: Angular<T, D>) -> Body<T, D> {
+        let b = &*self.balls;
+        Body::new_unchecked(
+            b.inverse_mass[i],
+            <Const<D> as Space<T, D>>::inertia_isotropic(b.inverse_inertia[i]),
+            v,
+            w,
+        )
+    }
+
+    /// Re-integrates ball `i` from its segment start to the end of the step.
+    fn reintegrate(&mut self, i: usize) {
+        let b = &mut *self.balls;
+        let (mut x, mut v, mut w) = (b.seg_x[i], b.seg_v[i], b.seg_w[i]);
+        let s = b.seg_t[i];
+        if let Ok(dt) = TimeStep::new(self.h - s) {
+            self.stepper
+                .step_ball(&mut x, &mut v, &mut w, b.inverse_mass[i], self.t0 + s, dt);
+        }
+        b.set_end(i, self.h, x, v, w);
+    }
+
+    /// Applies a collision's new physical velocities to ball `i` and re-integrates it:
+    /// it is no longer supported.
+    fn collide(&mut self, i: usize, s: T, v: Vector<T, D>, w: Angular<T, D>) {
+        self.balls.seg_v[i] = v;
+        self.balls.seg_w[i] = w;
+        self.reintegrate(i);
+        self.balls.supported[i] = false;
+        self.rest.restart(i, s, self.balls.chord[i]);
+    }
+
+    /// Two balls `i`, `j` (j's position shifted by `shift`) touching at `s`.
+    pub(crate) fn ball_ball(
+        &mut self,
+        i: usize,
+        j: usize,
+        shift: &Vector<T, D>,
+        s: T,
+        fallback_normal: &Vector<T, D>,
+    ) -> Effect {
+        let h = self.h;
+        self.balls.restart(i, s, h);
+        self.balls.restart(j, s, h);
+        let b = &*self.balls;
+        let offset = b.seg_x[j] + shift - b.seg_x[i];
+        let length = offset.norm();
+        let n = if length > T::zero() && length.finite() {
+            offset / length
+        } else {
+            *fallback_normal
+        };
+        let Ok(contact) = Contact::new(n, n * b.radius[i], n * -b.radius[j]) else {
+            return Effect::default();
+        };
+        let (bi, bj) = (
+            self.body(i, b.seg_v[i], b.seg_w[i]),
+            self.body(j, b.seg_v[j], b.seg_w[j]),
+        );
+        let approach = -normal_velocity(&bi, &bj, &contact);
+        let slow = approach <= self.rules.support_speed;
+        let down = self.rules.gravity.dot(&n);
+        // Ball j holds ball i (or i holds j): it is supported, lies below along gravity
+        // and does not move towards the other (n points from i to j).
+        let floor = self.rules.floor;
+        let j_holds = b.supported[j] && down > T::zero() && b.chord[j].dot(&n) >= -floor;
+        let i_holds = b.supported[i] && down < T::zero() && b.chord[i].dot(&n) <= floor;
+        // A slow contact onto a support is resting: no impulse, only the correction below.
+        let onto_support = slow && (j_holds || i_holds);
+        let nominal = b.restitution[i].min(b.restitution[j]);
+        let e = self
+            .rules
+            .collapse
+            .restitution(nominal, approach, [T::INFINITY, T::INFINITY]);
+        let r = resolve(
+            &bi,
+            &bj,
+            &contact,
+            &Coefficients::new_unchecked(e, self.rules.friction),
+        );
+        let effect = Effect {
+            collided: r.applied() && !slow,
+        };
+        if r.applied() && !onto_support {
+            for (k, ball, body) in [(0, i, bi), (1, j, bj)] {
+                let (v, w) = (r.velocity[k], r.angular_velocity[k]);
+                if slow {
+                    // Support-sized: no re-integration (it would add this step's gravity
+                    // again to balls the supports already hold).
+                    let dw = w - body.angular_velocity();
+                    self.balls.nudge(ball, h, &(v - body.velocity()), &dw);
+                    self.rest.restart(ball, s, self.balls.chord[ball]);
+                } else {
+                    self.collide(ball, s, v, w);
+                }
+            }
+        }
+        let b = &*self.balls;
+        if (b.chord[j] - b.chord[i]).dot(&n) >= T::zero() || s >= h {
+            return effect;
+        }
+        // Shock propagation: a ball resting on a supported ball below it, that does not
+        // move towards it, is held as by an immovable surface, and is supported in turn.
+        let j_holds = b.supported[j] && down > T::zero() && b.chord[j].dot(&n) >= -floor;
+        let i_holds = b.supported[i] && down < T::zero() && b.chord[i].dot(&n) <= floor;
+        if j_holds {
+            self.rest_on(i, Support::Ball(j as u32), &n, b.chord[j], b.seg_w[j], s);
+        } else if i_holds {
+            self.rest_on(j, Support::Ball(i as u32), &-n, b.chord[i], b.seg_w[i], s);
+        } else {
+            // Two free balls closing along their chords: a perfectly inelastic correction
+            // (momentum kept, energy never added).
+            let (ci, cj) = (
+                self.body(i, b.chord[i], b.seg_w[i]),
+                self.body(j, b.chord[j], b.seg_w[j]),
+            );
+            let r = resolve(
+                &ci,
+                &cj,
+                &contact,
+                &Coefficients::new_unchecked(T::zero(), self.rules.friction),
+            );
+            if r.applied() {
+                for (k, ball, body) in [(0, i, ci), (1, j, cj)] {
+                    let du = r.velocity[k] - body.velocity();
+                    let dw = r.angular_velocity[k] - body.angular_velocity();
+                    self.balls.shift_chord(ball, h, &du, &dw, &n);
+                    self.rest.restart(ball, s, self.balls.chord[ball]);
+                }
+            }
+        }
+        effect
+    }
+
+    /// Holds ball `i` on an immovable support it touches along `n` (from the ball into
+    /// the support), moving at `velocity` and spinning at `spin`: one support is a
+    /// restitution-0 impulse with friction on the chord; several at the same instant (the
+    /// ones corrected before, and every other support the ball touches now: walls, boxes,
+    /// supported balls below it) are the exact projection of the chord onto all of them
+    /// (see `rest`).
+    fn rest_on(
+        &mut self,
+        i: usize,
+        support: Support,
+        n: &Vector<T, D>,
+        velocity: Vector<T, D>,
+        spin: Angular<T, D>,
+        s: T,
+    ) {
+        let h = self.h;
+        let chord = self.balls.chord[i];
+        let set = self.rest.at(i, s, h * T::lit(1e-6), chord, false);
+        set.add(support, -n, -velocity.dot(n));
+        // Every other support the ball touches right now holds it too: all of them at
+        // once, so that it does not slide off one onto the next.
+        for (ball, touches) in self.touching {
+            if ball == i {
+                for t in touches.iter().filter(|t| t.support != support) {
+                    set.add(t.support, -t.normal, -t.velocity.dot(&t.normal));
+                }
+            }
+        }
+        let several = set.len() > 1;
+        let projected = if several { set.project() } else { None };
+        if let Some(u) = projected {
+            self.balls.hold(i, h, u);
+        } else {
+            let b = &*self.balls;
+            let Ok(contact) = Contact::new(*n, n * b.radius[i], Vector::zeros()) else {
+                return;
+            };
+            let other = Body::kinematic(velocity, spin).unwrap_or_else(|_| Body::fixed());
+            let ball = self.body(i, chord, b.seg_w[i]);
+            let r = resolve(
+                &ball,
+                &other,
+                &contact,
+                &Coefficients::new_unchecked(T::zero(), self.rules.friction),
+            );
+            if r.applied() {
+                let du = r.velocity[0] - ball.velocity();
+                let dw = r.angular_velocity[0] - ball.angular_velocity();
+                self.balls.shift_chord(i, h, &du, &dw, n);
+            }
+        }
+        self.balls.supported[i] = true;
+    }
+
+    /// Ball `i` touching a wall or a box along `n` (from the ball into the surface) at `s`.
+    pub(crate) fn ball_surface(
+        &mut self,
+        i: usize,
+        surface: Surface<T, D>,
+        n: &Vector<T, D>,
+        s: T,
+    ) -> Effect {
+        let h = self.h;
+        self.balls.restart(i, s, h);
+        let (surface_velocity, nominal, support) = match surface {
+            Surface::Wall => {
+                let axis = n.iamax();
+                (
+                    Vector::zeros(),
+                    self.rules.border_restitution,
+                    Support::Wall(axis, n[axis] > T::zero()),
+                )
+            }
+            Surface::Box(k, v) => (v, self.boxes.restitution[k], Support::Box(k as u32)),
+        };
+        let zero_spin = <Const<D> as Space<T, D>>::angular_zero();
+        let other = Body::kinematic(surface_velocity, zero_spin).unwrap_or_else(|_| Body::fixed());
+        let b = &*self.balls;
+        let Ok(contact) = Contact::new(*n, n * b.radius[i], Vector::zeros()) else {
+            return Effect::default();
+        };
+        let ball = self.body(i, b.seg_v[i], b.seg_w[i]);
+        let approach = -normal_velocity(&ball, &other, &contact);
+        let mut effect = Effect::default();
+        // A support-sized approach is a resting contact: only the correction below.
+        if approach > self.rules.support_speed {
+            let e = match self
+                .rules
+                .resting
+                .decide(approach, nominal, self.rules.gravity.dot(n))
+            {
+                Bounce::Rebound => nominal,
+                Bounce::Rest => T::zero(),
+            };
+            let r = resolve(
+                &ball,
+                &other,
+                &contact,
+                &Coefficients::new_unchecked(e, self.rules.friction),
+            );
+            if r.applied() {
+                effect.collided = true;
+                self.collide(i, s, r.velocity[0], r.angular_velocity[0]);
+            }
+        }
+        if (surface_velocity - self.balls.chord[i]).dot(n) < T::zero() && s < h {
+            self.rest_on(i, support, n, surface_velocity, zero_spin, s);
+        }
+        effect
+    }
+}

@@ -1,0 +1,326 @@
+//! The broad phase: which balls (and boxes) can meet within a step, kept valid over
+//! several steps, and exact while collisions change the balls' paths.
+//!
+//! Each ball is entered as its **reach box**: the axis-aligned box around the ball of
+//! radius `r + max(|u|, ū) τ` centred at its position when the broad phase is built, with
+//! `u` its chord velocity, `ū` the scene's mean chord speed and `τ` the reach time:
+//! [`REACH_STEPS`] steps in open space, the window in a periodic domain. It holds the
+//! ball's path for that long, and every path that leaves from a point of the chord at no
+//! more than the same speed, so a ball that bounces back stays inside. Boxes (walls,
+//! paddles) are entered as the box swept over the same time, except in a periodic domain,
+//! where boxes are tested against every ball with their periodic images (see `narrow`).
+//! carom-broad returns the overlapping pairs; the narrow phase computes a time of impact
+//! for each, every step.
+//!
+//! At the start of each step every ball's path for the step is checked against its entry
+//! (in parallel). A ball whose path left its entry, or whose path leaves it later in the
+//! step after a collision (it was hit by a faster ball), is an **escapee**: its path box is
+//! kept in a short list, and every prediction for it queries the broad phase and scans the
+//! list. The invariant that makes this exact: every ball's remaining path lies in its
+//! entry or, for an escapee, in its listed box; a prediction queries the broad phase with
+//! the ball's path box and scans the escapees, so no pair that can touch is missed. When
+//! the list grows past a bound (a sixteenth of the balls, at least 64), the broad phase is
+//! rebuilt: at the start of a step, or mid-step by ending the window at the current time
+//! (bounded work; see `StepStats::windows` and `StepStats::rebuilds`).
+
+use carom_broad::{BruteForce, KdTree, ParallelBroadPhase, SweepAndPrune, UniformGrid, Volumes};
+use carom_geometry::{Aabb, Border};
+use carom_math::{Real, Space, Vector};
+use nalgebra::Const;
+use rayon::prelude::*;
+
+use super::balls::BallArrays;
+use super::obstacles::BoxArrays;
+use crate::plan::BroadChoice;
+
+/// Balls per parallel chunk of the data-parallel passes.
+pub(crate) const CHUNK: usize = 1024;
+
+/// How many steps of travel a reach box holds in open space: the broad phase is rebuilt
+/// about this often in a gas (more pairs to test per step, fewer builds).
+pub(crate) const REACH_STEPS: u32 = 4;
+
+/// The broad phase and its buffers.
+pub(crate) struct Sweep<T: Real, const D: usize> {
+    phase: Box<dyn ParallelBroadPhase<T, D>>,
+    choice: BroadChoice,
+    /// Boxes take part (open space); in a periodic domain they are tested separately.
+    boxes_inside: bool,
+    /// The entries are built and may serve the next step (open space only).
+    built: bool,
+    /// The number of balls (volumes past it are boxes).
+    balls: usize,
+    /// Whether each ball's path fits its entry at the start of a step (scratch).
+    fits: Vec<bool>,
+    /// Per-chunk sums (scratch).
+    sums: Vec<T>,
+    /// Builds so far.
+    builds: u64,
+    /// Reach boxes of the balls, then (open space) the swept boxes.
+    volumes: Vec<Aabb<T, D>>,
+    /// This window's overlapping pairs.
+    pub(crate) pairs: Vec<(u32, u32)>,
+    /// Query results.
+    hits: Vec<u32>,
+    /// The escapees, in the order they escaped.
+    escaped: Vec<u32>,
+    /// Per ball: its escapee box, if it escaped.
+    escape_box: Vec<Option<Aabb<T, D>>>,
+}
+
+impl<T: Real, const D: usize> Sweep<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// A broad phase of kind `choice` (already resolved, never `Auto`) for `n` balls, in
+    /// the periodic domain `periodic` if given.
+    pub(crate) fn new(choice: BroadChoice, n: usize, periodic: Option<&Border<T, D>>) -> Self {
+        let phase: Box<dyn ParallelBroadPhase<T, D>> = match (choice, periodic) {
+            (BroadChoice::Brute | BroadChoice::Auto, None) => Box::new(BruteForce::new()),
+            (BroadChoice::Brute | BroadChoice::Auto, Some(b)) => Box::new(BruteForce::periodic(b)),
+            (BroadChoice::Sap, _) => Box::new(SweepAndPrune::new()),
+            (BroadChoice::Kd, _) => Box::new(KdTree::new()),
+            (BroadChoice::Grid, None) => Box::new(UniformGrid::dense()),
+            (BroadChoice::Grid, Some(b)) => Box::new(UniformGrid::periodic(*b)),
+        };
+        Self {
+            phase,
+            choice,
+            boxes_inside: periodic.is_none(),
+            built: false,
+            balls: n,
+            fits: Vec::with_capacity(n),
+            sums: Vec::new(),
+            builds: 0,
+            volumes: Vec::with_capacity(n),
+            pairs: Vec::new(),
+            hits: Vec::new(),
+            escaped: Vec::new(),
+            escape_box: vec![None; n],
+        }
+    }
+
+    /// The pipeline name of this broad phase.
+    pub(crate) fn name(&self) -> &'static str {
+        match self.choice {
+            BroadChoice::Brute | BroadChoice::Auto => "broad:brute-force",
+            BroadChoice::Sap => "broad:sweep-and-prune",
+            BroadChoice::Kd => "broad:kd-tree",
+            BroadChoice::Grid => "broad:uniform-grid",
+        }
+    }
+
+    /// Whether boxes are volumes of this broad phase (index `n + k` for box `k`).
+    pub(crate) fn boxes_inside(&self) -> bool {
+        self.boxes_inside
+    }
+
+    /// Makes the broad phase valid for a step of length `h` whose paths start at in-step
+    /// time 0: keeps the entries if every ball's path and every box's sweep still fits
+    /// (balls that do not fit become escapees, up to the bound), rebuilds them otherwise.
+    /// Returns the escapees the caller must predict by query (empty after a rebuild).
+    pub(crate) fn begin_step(
+        &mut self,
+        balls: &BallArrays<T, D>,
+        boxes: &BoxArrays<T, D>,
+        h: T,
+        escape_bound: usize,
+        parallel: bool,
+    ) -> &[u32] {
+        self.clear_escapees();
+        if self.built && self.boxes_fit(boxes, h) {
+            let n = balls.len();
+            self.fits.resize(n, true);
+            let volumes = &self.volumes;
+            fill(&mut self.fits, parallel, |i| {
+                contains(
+                    &volumes[i],
+                    &path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]),
+                )
+            });
+            for (i, _) in self.fits.iter().enumerate().filter(|(_, fits)| !**fits) {
+                if self.escaped.len() >= escape_bound {
+                    break;
+                }
+                self.escaped.push(i as u32);
+                self.escape_box[i] =
+                    Some(path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]));
+            }
+            if self.escaped.len() < escape_bound {
+                return &self.escaped;
+            }
+            self.clear_escapees();
+        }
+        let reach = h * T::from_count(REACH_STEPS as usize);
+        self.build(balls, boxes, T::zero(), reach, parallel);
+        &self.escaped
+    }
+
+    fn boxes_fit(&self, boxes: &BoxArrays<T, D>, h: T) -> bool {
+        !self.boxes_inside
+            || (0..boxes.len())
+                .all(|k| contains(&self.volumes[self.balls + k], &boxes.swept(k, T::zero(), h)))
+    }
+
+    fn clear_escapees(&mut self) {
+        for &e in &self.escaped {
+            self.escape_box[e as usize] = None;
+        }
+        self.escaped.clear();
+    }
+
+    /// Rebuilds from the balls' paths at in-step time `a`, each ball reaching as far as
+    /// it travels in `reach` (at least the mean travel), plus the boxes swept over the
+    /// same time (open space only), and finds the pairs.
+    pub(crate) fn build(
+        &mut self,
+        balls: &BallArrays<T, D>,
+        boxes: &BoxArrays<T, D>,
+        a: T,
+        reach: T,
+        parallel: bool,
+    ) {
+        let n = balls.len();
+        self.clear_escapees();
+        let mean = chunked_sum(&balls.chord, parallel, &mut self.sums, Vector::norm)
+            / T::from_count(n.max(1));
+        self.volumes
+            .resize(n, Aabb::new_unchecked(Vector::zeros(), Vector::zeros()));
+        let entry = |i: usize| {
+            let x = balls.position_at(i, a);
+            reach_box(&x, balls.radius[i], balls.chord[i].norm().max(mean) * reach)
+        };
+        fill(&mut self.volumes, parallel, entry);
+        if self.boxes_inside {
+            self.volumes
+                .extend((0..boxes.len()).map(|k| boxes.swept(k, a, a + reach)));
+        }
+        // Counts below u32::MAX are checked when the engine is built.
+        let volumes = Volumes::Boxes(&self.volumes);
+        if parallel {
+            self.phase.par_update(volumes);
+            self.phase.par_pairs(&mut self.pairs);
+        } else {
+            self.phase.update(volumes);
+            self.phase.pairs(&mut self.pairs);
+        }
+        self.built = self.boxes_inside;
+        self.builds += 1;
+    }
+
+    /// Builds so far.
+    pub(crate) fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    /// Whether `path` (a ball's remaining path box) lies in ball `i`'s entry.
+    fn holds(&self, i: usize, path: &Aabb<T, D>) -> bool {
+        contains(
+            self.escape_box[i].as_ref().unwrap_or(&self.volumes[i]),
+            path,
+        )
+    }
+
+    /// Records that ball `i`'s remaining path now has the box `path`: if it leaves the
+    /// ball's entry, the ball becomes (or stays) an escapee with that box. Returns the
+    /// number of escapees.
+    pub(crate) fn moved(&mut self, i: usize, path: Aabb<T, D>) -> usize {
+        if !self.holds(i, &path) {
+            if self.escape_box[i].is_none() {
+                self.escaped.push(i as u32);
+            }
+            self.escape_box[i] = Some(path);
+        }
+        self.escaped.len()
+    }
+
+    /// The `k`-th escapee.
+    pub(crate) fn escapee(&self, k: usize) -> usize {
+        self.escaped[k] as usize
+    }
+
+    /// The candidates a ball whose remaining path box is `path` can meet: indices of
+    /// balls (`< n`) and boxes (`n + k`, open space only) from the broad phase, then the
+    /// escapees whose boxes overlap `path`, into `out` (cleared first; may repeat).
+    pub(crate) fn candidates(&mut self, path: &Aabb<T, D>, out: &mut Vec<u32>) {
+        self.phase.query_aabb(path, &mut self.hits);
+        out.clear();
+        out.extend_from_slice(&self.hits);
+        for &e in &self.escaped {
+            if let Some(b) = &self.escape_box[e as usize]
+                && overlap(b, path)
+            {
+                out.push(e);
+            }
+        }
+    }
+}
+
+/// `out[i] = f(i)` for every entry, in parallel chunks if asked.
+fn fill<V: Send>(out: &mut [V], parallel: bool, f: impl Fn(usize) -> V + Sync) {
+    if parallel {
+        out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, part)| {
+            for (k, v) in part.iter_mut().enumerate() {
+                *v = f(c * CHUNK + k);
+            }
+        });
+    } else {
+        for (i, v) in out.iter_mut().enumerate() {
+            *v = f(i);
+        }
+    }
+}
+
+/// `Σ f(x)` over `items`, summed in fixed chunks of [`CHUNK`] and then in chunk order:
+/// the same bits on any number of threads.
+pub(crate) fn chunked_sum<X: Sync, T: Real>(
+    items: &[X],
+    parallel: bool,
+    scratch: &mut Vec<T>,
+    f: impl Fn(&X) -> T + Sync,
+) -> T {
+    let part = |c: &[X]| c.iter().fold(T::zero(), |sum, x| sum + f(x));
+    if parallel {
+        items.par_chunks(CHUNK).map(part).collect_into_vec(scratch);
+        scratch.iter().fold(T::zero(), |sum, &x| sum + x)
+    } else {
+        items
+            .chunks(CHUNK)
+            .map(part)
+            .fold(T::zero(), |sum, x| sum + x)
+    }
+}
+
+/// Whether `inner` lies in `outer`.
+fn contains<T: Real, const D: usize>(outer: &Aabb<T, D>, inner: &Aabb<T, D>) -> bool {
+    (0..D).all(|k| outer.min()[k] <= inner.min()[k] && inner.max()[k] <= outer.max()[k])
+}
+
+/// Whether two boxes overlap or touch.
+pub(crate) fn overlap<T: Real, const D: usize>(a: &Aabb<T, D>, b: &Aabb<T, D>) -> bool {
+    (0..D).all(|k| a.min()[k] <= b.max()[k] && b.min()[k] <= a.max()[k])
+}
+
+/// Rounding allowance of a box around `center` of half size `half`: positions computed
+/// as `x + u·s` may land a few ulps outside the exact box.
+fn pad<T: Real, const D: usize>(center: &Vector<T, D>, half: T) -> T {
+    T::lit(8.0) * T::EPSILON * (center.amax() + half)
+}
+
+/// The box around the ball of radius `r + reach` centred at `x`.
+pub(crate) fn reach_box<T: Real, const D: usize>(x: &Vector<T, D>, r: T, reach: T) -> Aabb<T, D> {
+    let half = r + reach;
+    let h = Vector::<T, D>::repeat(half + pad(x, half));
+    Aabb::new_unchecked(x - h, x + h)
+}
+
+/// The box swept by a ball of radius `r` moving straight from `from` to `to`.
+pub(crate) fn path_box<T: Real, const D: usize>(
+    from: &Vector<T, D>,
+    to: &Vector<T, D>,
+    r: T,
+) -> Aabb<T, D> {
+    let half = r + pad(from, r).max(pad(to, r));
+    let h = Vector::<T, D>::repeat(half);
+    Aabb::new_unchecked(from.inf(to) - h, from.sup(to) + h)
+}

@@ -1,0 +1,265 @@
+//! Resting contacts under gravity: balls on the floor, on a table box, on a slope, on a
+//! rising platform and on each other must neither sink nor jitter, nor gain energy.
+//!
+//! Independent references: a resting stack does not move; a frictionless ball on a
+//! slope of angle θ slides with acceleration `g sin θ` (exactly, with the exact
+//! integrator: the resting correction keeps the tangential motion of the step); a disk
+//! sliding on a table with friction rolls off at `2/3` of its speed (angular momentum
+//! about the contact point is conserved); a ball on a platform rising at constant speed
+//! moves with it.
+
+mod common;
+
+use carom_geometry::{Border, Obb};
+use carom_integrate::Integrator;
+use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
+use carom_sim::{Simulation, observe};
+use common::{Recorder, states, stepped};
+use nalgebra::Vector2;
+
+const G: f64 = 9.81;
+
+fn floor_world(restitution: f64, friction: f64, width: f64) -> World<f64, 2> {
+    World {
+        gravity: Vector2::new(0.0, -G),
+        restitution,
+        friction,
+        border: Some(BorderSpec {
+            border: Border::new(
+                Vector2::new(-width / 2.0, 0.0),
+                Vector2::new(width / 2.0, 10.0),
+            )
+            .unwrap(),
+            restitution,
+            periodic: false,
+        }),
+        ..World::default()
+    }
+}
+
+/// Runs `scene` for `t` seconds and checks that nothing moved, nothing was reported and
+/// the energy is unchanged; returns the most contacts a step needed.
+fn assert_at_rest(scene: &Scene<f64, 2>, integrator: Integrator, t: f64) -> u64 {
+    let mut sim = stepped(scene, integrator, 1.0 / 600.0);
+    let start = states(&sim);
+    let e0 = observe::energy(scene, &start);
+    let mut rec = Recorder::default();
+    for k in 1..=10 {
+        sim.advance_to(t * f64::from(k) / 10.0, &mut rec).unwrap();
+        let now = states(&sim);
+        for (i, (p, q)) in now.pos.iter().zip(&start.pos).enumerate() {
+            assert!(
+                (p - q).norm() < 1e-9,
+                "{integrator}: ball {i} moved from {q:?} to {p:?}"
+            );
+            assert!(now.vel[i].norm() < 1e-9, "{integrator}: ball {i} moves");
+        }
+        let e = observe::energy(scene, &now);
+        assert!(
+            (e - e0).abs() < 1e-9 * e0.abs(),
+            "{integrator}: {e0} -> {e}"
+        );
+    }
+    assert!(
+        rec.collisions.is_empty(),
+        "{:?}",
+        &rec.collisions[..3.min(rec.collisions.len())]
+    );
+    sim.stats().max_contacts_in_step
+}
+
+#[test]
+fn a_column_of_balls_on_the_floor_stays_put() {
+    for e in [0.0, 0.5, 1.0] {
+        let balls = (0..5)
+            .map(|k| {
+                BallSpec::new(
+                    Vector2::new(0.0, 0.1 + 0.2 * f64::from(k)),
+                    Vector2::zeros(),
+                    0.1,
+                    1.0,
+                )
+            })
+            .collect();
+        let s = Scene {
+            world: floor_world(e, 0.0, 2.0),
+            balls,
+            ..Scene::default()
+        };
+        for integrator in [
+            Integrator::SemiImplicitEuler,
+            Integrator::Exact,
+            Integrator::Rk4,
+        ] {
+            let most = assert_at_rest(&s, integrator, 10.0);
+            // Settled from the floor up: one resting contact per ball and step.
+            assert!(
+                most <= 5,
+                "{integrator}, e = {e}: {most} contacts in a step"
+            );
+        }
+    }
+}
+
+/// A pyramid of `rows` rows on a floor `width` wide (a multiple of the diameter 0.2),
+/// the bottom row filling it from wall to wall.
+fn pyramid(width: f64, rows: u32, friction: f64) -> Scene<f64, 2> {
+    let r = 0.1;
+    let rise = 2.0 * r * (3.0_f64).sqrt() / 2.0;
+    let base = (width / (2.0 * r)).round() as u32;
+    let mut balls = Vec::new();
+    for row in 0..rows {
+        for k in 0..base - row {
+            let x = -width / 2.0 + r + r * f64::from(row) + 2.0 * r * f64::from(k);
+            balls.push(BallSpec::new(
+                Vector2::new(x, r + rise * f64::from(row)),
+                Vector2::zeros(),
+                r,
+                1.0,
+            ));
+        }
+    }
+    Scene {
+        world: floor_world(0.5, friction, width),
+        balls,
+        ..Scene::default()
+    }
+}
+
+#[test]
+fn packed_pyramids_between_walls_stay_put() {
+    for (width, rows) in [(0.8, 4), (2.0, 10), (4.0, 6)] {
+        let s = pyramid(width, rows, 0.0);
+        let n = s.balls.len() as u64;
+        let most = assert_at_rest(&s, Integrator::SemiImplicitEuler, 2.0);
+        assert!(most <= 2 * n, "{n} balls: {most} contacts in a step");
+    }
+    let s = pyramid(1.2, 6, 0.4);
+    assert_at_rest(&s, Integrator::Exact, 2.0);
+}
+
+/// A table: a box whose top is at `y = 0`, tilted by `angle` about its centre.
+fn table(angle: f64) -> BoxSpec<f64, 2> {
+    BoxSpec {
+        shape: Obb::from_angle(Vector2::zeros(), Vector2::new(2.0, 0.05), angle).unwrap(),
+        vel: Vector2::zeros(),
+        restitution: 0.5,
+    }
+}
+
+#[test]
+fn a_frictionless_ball_slides_down_a_slope_at_g_sin_theta() {
+    let (theta, r) = (0.3_f64, 0.1);
+    let (along, normal) = (
+        Vector2::new(theta.cos(), theta.sin()),
+        Vector2::new(-theta.sin(), theta.cos()),
+    );
+    let start = normal * (0.05 + r);
+    let s = Scene {
+        world: World {
+            gravity: Vector2::new(0.0, -G),
+            ..World::default()
+        },
+        balls: vec![BallSpec::new(start, Vector2::zeros(), r, 1.0)],
+        boxes: vec![table(theta)],
+        ..Scene::default()
+    };
+    let mut sim = stepped(&s, Integrator::Exact, 1.0 / 600.0);
+    let mut rec = Recorder::default();
+    for k in 1..=10 {
+        let t = 0.05 * f64::from(k);
+        sim.advance_to(t, &mut rec).unwrap();
+        let p = states(&sim).pos[0] - start;
+        let slid = -0.5 * G * theta.sin() * t * t;
+        assert!((p.dot(&along) - slid).abs() < 1e-9, "t = {t}: {p:?}");
+        assert!(
+            p.dot(&normal).abs() < 1e-9,
+            "t = {t}: off the slope by {}",
+            p.dot(&normal)
+        );
+    }
+    assert!(rec.collisions.is_empty());
+}
+
+#[test]
+fn a_disk_sliding_on_a_table_rolls_off_at_two_thirds_of_its_speed() {
+    let (r, v0, mu) = (0.1, 2.0, 0.3);
+    let s = Scene {
+        world: World {
+            gravity: Vector2::new(0.0, -G),
+            friction: mu,
+            ..World::default()
+        },
+        balls: vec![BallSpec::new(
+            Vector2::new(-1.5, 0.05 + r),
+            Vector2::new(v0, 0.0),
+            r,
+            1.0,
+        )],
+        boxes: vec![table(0.0)],
+        ..Scene::default()
+    };
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, 1.0 / 600.0);
+    // Sliding friction μ g slows it until it rolls at t = v₀/(3 μ g) ≈ 0.23 s.
+    sim.advance_to(0.4, &mut ()).unwrap();
+    let st = states(&sim);
+    assert!(
+        (st.vel[0].x - 2.0 * v0 / 3.0).abs() < 1e-9,
+        "{:?}",
+        st.vel[0]
+    );
+    assert!(st.vel[0].y.abs() < 1e-12);
+    // Rolling to +x turns clockwise: ω = −v/r.
+    assert!(
+        (st.spin[0].x + st.vel[0].x / r).abs() < 1e-8,
+        "{:?}",
+        st.spin[0]
+    );
+    assert!((st.pos[0].y - (0.05 + r)).abs() < 1e-12);
+}
+
+#[test]
+fn a_ball_rides_a_rising_platform() {
+    let (r, up) = (0.1, 0.5);
+    let s = Scene {
+        world: World {
+            gravity: Vector2::new(0.0, -G),
+            ..World::default()
+        },
+        balls: vec![BallSpec::new(
+            Vector2::new(0.0, 0.05 + r),
+            Vector2::new(0.0, up),
+            r,
+            1.0,
+        )],
+        boxes: vec![BoxSpec {
+            vel: Vector2::new(0.0, up),
+            ..table(0.0)
+        }],
+        ..Scene::default()
+    };
+    for integrator in [Integrator::SemiImplicitEuler, Integrator::Exact] {
+        let mut sim = stepped(&s, integrator, 1.0 / 600.0);
+        let mut rec = Recorder::default();
+        for k in 1..=20 {
+            let t = 0.1 * f64::from(k);
+            sim.advance_to(t, &mut rec).unwrap();
+            let st = states(&sim);
+            let top = sim.box_center(0).unwrap().y + 0.05;
+            assert!(
+                (top - (0.05 + up * t)).abs() < 1e-12,
+                "the platform moves on schedule"
+            );
+            assert!(
+                (st.pos[0].y - (top + r)).abs() < 1e-9,
+                "{integrator} t = {t}"
+            );
+            assert!(
+                (st.vel[0].y - up).abs() < 1e-9,
+                "{integrator} t = {t}: {:?}",
+                st.vel[0]
+            );
+        }
+        assert!(rec.collisions.is_empty());
+    }
+}
