@@ -107,7 +107,9 @@ fn zeno_bouncing_ends_in_rest_after_the_guards_count_of_bounces() {
     let mut sim = stepped(&s, Integrator::Exact, dt);
     let mut rec = Recorder::default();
     let v0 = (2.0 * G * 1.0_f64).sqrt();
-    let reported = (0..64).take_while(|&k| e.powi(k) * v0 > 2.0 * G * dt).count();
+    let reported = (0..64)
+        .take_while(|&k| e.powi(k) * v0 > 2.0 * G * dt)
+        .count();
     let mut energy = observe::energy(&s, &states(&sim));
     for k in 1..=3000 {
         sim.advance_to(f64::from(k) * dt, &mut rec).unwrap();
