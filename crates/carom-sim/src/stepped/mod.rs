@@ -53,8 +53,8 @@ use self::response::{Contacts, Effect, RestSets, Rules, Surface};
 use self::rest::{Support, Touch};
 use self::sweep::{CHUNK, REACH_STEPS, Sweep, path_box};
 use crate::engine::{BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation};
-use crate::plan::{DEFAULT_DT, Plan, stepped_broad_phase};
-use crate::scene::{Inelastic, Scene, SceneError};
+use crate::plan::{DEFAULT_DT, Plan, can_stick, stepped_broad_phase};
+use crate::scene::{Scene, SceneError};
 
 /// How often [`Observer::progress`] is called: every this many steps.
 const PROGRESS_EVERY: u64 = 256;
@@ -156,18 +156,16 @@ where
     /// The first rule of [`Scene::validate`] the scene breaks; `--dt` if the step is not
     /// finite and positive in this precision; `--broad` for a broad phase that cannot
     /// serve a periodic border; `world.border` for a periodic border too small for its
-    /// balls (two ball diameters must fit in half a period); `world.inelastic` for stick
-    /// clusters, which this engine does not simulate yet.
+    /// balls (two ball diameters must fit in half a period); `world.inelastic` for a
+    /// scene whose balls can stick ([`can_stick`]): this engine does not simulate stuck
+    /// clusters.
     pub fn new(scene: &Scene<T, D>, plan: &Plan, direction: Direction) -> Result<Self, SceneError> {
         scene.validate()?;
         let n = scene.balls.len();
         if u32::try_from(n + scene.boxes.len()).is_err() {
             return Err(SceneError::new("balls", "more than 2^32 balls and boxes"));
         }
-        if scene.world.inelastic == Inelastic::Stick
-            && (scene.world.restitution == T::zero()
-                || scene.balls.iter().any(|b| b.restitution == Some(T::zero())))
-        {
+        if can_stick(scene) {
             return Err(SceneError::new(
                 "world.inelastic",
                 "\"stick\" clusters are not simulated by the stepped engine; use --engine event (2D) or inelastic = \"slide\"",
