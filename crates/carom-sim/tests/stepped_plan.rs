@@ -34,35 +34,61 @@ fn auto_chooses_the_stepped_engine_for_drag_and_builds_it() {
         "field:linear-drag",
         "guard:resting",
     ] {
-        assert!(pipeline.iter().any(|p| p == name), "{name} missing: {pipeline:?}");
+        assert!(
+            pipeline.iter().any(|p| p == name),
+            "{name} missing: {pipeline:?}"
+        );
     }
     // What the scene does not use is not in the pipeline.
-    for absent in ["narrow:ball-ball", "narrow:ball-box", "response:friction", "periodic-border"] {
-        assert!(!pipeline.iter().any(|p| p == absent), "{absent} present: {pipeline:?}");
+    for absent in [
+        "narrow:ball-ball",
+        "narrow:ball-box",
+        "response:friction",
+        "periodic-border",
+    ] {
+        assert!(
+            !pipeline.iter().any(|p| p == absent),
+            "{absent} present: {pipeline:?}"
+        );
     }
 }
 
 #[test]
 fn the_broad_phase_is_chosen_from_the_scene_and_refused_where_it_cannot_work() {
     let small = classic::head_on(1.0, 1.0, 1.0, -1.0, 1.0);
-    assert_eq!(stepped_broad_phase(&small, BroadChoice::Auto), Ok(BroadChoice::Brute));
+    assert_eq!(
+        stepped_broad_phase(&small, BroadChoice::Auto),
+        Ok(BroadChoice::Brute)
+    );
     let mut many = gas::<2>(&GasParams::default()).unwrap();
-    assert_eq!(stepped_broad_phase(&many, BroadChoice::Auto), Ok(BroadChoice::Grid));
+    assert_eq!(
+        stepped_broad_phase(&many, BroadChoice::Auto),
+        Ok(BroadChoice::Grid)
+    );
     many.balls[0].radius = 0.01;
-    assert_eq!(stepped_broad_phase(&many, BroadChoice::Auto), Ok(BroadChoice::Sap));
+    assert_eq!(
+        stepped_broad_phase(&many, BroadChoice::Auto),
+        Ok(BroadChoice::Sap)
+    );
     let periodic = gas::<2>(&GasParams {
         periodic: true,
         ..GasParams::default()
     })
     .unwrap();
-    assert_eq!(stepped_broad_phase(&periodic, BroadChoice::Auto), Ok(BroadChoice::Grid));
+    assert_eq!(
+        stepped_broad_phase(&periodic, BroadChoice::Auto),
+        Ok(BroadChoice::Grid)
+    );
     let options = RunOptions {
         engine: EngineChoice::Stepped,
         broad: BroadChoice::Kd,
         ..RunOptions::default()
     };
     let e = plan(&periodic, &options).unwrap_err();
-    assert!(e.0.starts_with("--broad kd: the scene has a periodic border"), "{e}");
+    assert!(
+        e.0.starts_with("--broad kd: the scene has a periodic border"),
+        "{e}"
+    );
     // Every broad phase gives the same run.
     let s = gas::<2>(&GasParams {
         n: 200,
@@ -70,16 +96,26 @@ fn the_broad_phase_is_chosen_from_the_scene_and_refused_where_it_cannot_work() {
         ..GasParams::default()
     })
     .unwrap();
-    let hashes: Vec<u64> = [BroadChoice::Brute, BroadChoice::Sap, BroadChoice::Kd, BroadChoice::Grid]
-        .into_iter()
-        .map(|broad| {
-            let mut sim =
-                common::stepped_with(&s, Integrator::VelocityVerlet, 1.0 / 60.0, broad, Direction::Forward);
-            sim.advance_to(2.0, &mut ()).unwrap();
-            assert!(sim.pipeline().iter().any(|p| p.starts_with("broad:")));
-            carom_sim::observe::state_hash(&common::states(&sim))
-        })
-        .collect();
+    let hashes: Vec<u64> = [
+        BroadChoice::Brute,
+        BroadChoice::Sap,
+        BroadChoice::Kd,
+        BroadChoice::Grid,
+    ]
+    .into_iter()
+    .map(|broad| {
+        let mut sim = common::stepped_with(
+            &s,
+            Integrator::VelocityVerlet,
+            1.0 / 60.0,
+            broad,
+            Direction::Forward,
+        );
+        sim.advance_to(2.0, &mut ()).unwrap();
+        assert!(sim.pipeline().iter().any(|p| p.starts_with("broad:")));
+        carom_sim::observe::state_hash(&common::states(&sim))
+    })
+    .collect();
     assert!(hashes.windows(2).all(|w| w[0] == w[1]), "{hashes:x?}");
 }
 
@@ -95,12 +131,16 @@ fn bad_scenes_and_options_are_errors_naming_the_field() {
     .unwrap();
     let mut bad = classic::head_on(1.0, 1.0, 1.0, -1.0, 1.0);
     bad.balls[1].radius = -0.1;
-    let e = SteppedEngine::new(&bad, &p, Direction::Forward).err().unwrap();
+    let e = SteppedEngine::new(&bad, &p, Direction::Forward)
+        .err()
+        .unwrap();
     assert_eq!(e.to_string(), "balls[1].radius: must be > 0, got -0.1");
     let mut tiny = p;
     tiny.dt = Some(1e-60);
     let f32_scene: Scene<f32, 2> = classic::head_on(1.0, 1.0, 1.0, -1.0, 1.0).cast().unwrap();
-    let e = SteppedEngine::new(&f32_scene, &tiny, Direction::Forward).err().unwrap();
+    let e = SteppedEngine::new(&f32_scene, &tiny, Direction::Forward)
+        .err()
+        .unwrap();
     assert_eq!(e.field, "--dt");
     // A periodic box must hold two diameters in half a period.
     let crowded = Scene {
@@ -112,10 +152,17 @@ fn bad_scenes_and_options_are_errors_naming_the_field() {
             }),
             ..World::default()
         },
-        balls: vec![BallSpec::new(Vector2::new(0.5, 0.5), Vector2::zeros(), 0.3, 1.0)],
+        balls: vec![BallSpec::new(
+            Vector2::new(0.5, 0.5),
+            Vector2::zeros(),
+            0.3,
+            1.0,
+        )],
         ..Scene::default()
     };
-    let e = SteppedEngine::new(&crowded, &p, Direction::Forward).err().unwrap();
+    let e = SteppedEngine::new(&crowded, &p, Direction::Forward)
+        .err()
+        .unwrap();
     assert_eq!(e.field, "world.border");
 }
 
@@ -134,11 +181,22 @@ fn stick_scenes_are_refused_naming_world_inelastic() {
     // The engine itself refuses too, whatever plan it is given.
     let slide = classic::head_on(1.0, 1.0, 1.0, -1.0, 0.0);
     let p = plan(&slide, &stepped).unwrap();
-    assert_eq!(SteppedEngine::new(&s, &p, Direction::Forward).err().unwrap().field, "world.inelastic");
+    assert_eq!(
+        SteppedEngine::new(&s, &p, Direction::Forward)
+            .err()
+            .unwrap()
+            .field,
+        "world.inelastic"
+    );
     // 3D on auto: no engine can run it; the message says what to change.
     let mut s3 = classic::ball_drop::<3>(1.0, 0.0);
     s3.world.inelastic = Inelastic::Stick;
-    s3.balls.push(BallSpec::new(Vector3::new(0.5, 0.0, 0.5), Vector3::zeros(), 0.1, 1.0));
+    s3.balls.push(BallSpec::new(
+        Vector3::new(0.5, 0.0, 0.5),
+        Vector3::zeros(),
+        0.1,
+        1.0,
+    ));
     let e = plan(&s3, &RunOptions::default()).unwrap_err();
     assert!(e.0.contains("inelastic = \"slide\""), "{e}");
     // A per-ball restitution of 0 sticks too; restitution above 0 everywhere does not.
