@@ -149,6 +149,17 @@ pub fn event_engine_limitation<T: Real, const D: usize>(
     None
 }
 
+/// Whether two balls of `scene` can stick: `inelastic = "stick"` and some ball's
+/// restitution (its override, or the world's) is 0, so every pair with it has
+/// restitution 0.
+pub fn can_stick<T: Real, const D: usize>(scene: &Scene<T, D>) -> bool {
+    scene.world.inelastic == Inelastic::Stick
+        && scene
+            .balls
+            .iter()
+            .any(|b| b.restitution.unwrap_or(scene.world.restitution) == T::zero())
+}
+
 /// Below this many balls the stepped engine's automatic broad phase tests every pair.
 pub const STEPPED_BRUTE_FORCE_BELOW: usize = 64;
 
@@ -234,6 +245,16 @@ pub fn plan<T: Real, const D: usize>(
         )));
     }
     if engine == EngineKind::Stepped {
+        if can_stick(scene) {
+            return Err(PlanError(format!(
+                "world.inelastic = \"stick\": the stepped engine does not simulate stuck clusters{}",
+                if D == 2 {
+                    "; use --engine event (or auto)"
+                } else {
+                    ", and the event engine cannot tumble them in 3D: use inelastic = \"slide\""
+                }
+            )));
+        }
         stepped_broad_phase(scene, options.broad)?;
     }
     if engine == EngineKind::Event && matches!(options.broad, BroadChoice::Sap | BroadChoice::Kd) {

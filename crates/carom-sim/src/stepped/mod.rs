@@ -51,10 +51,10 @@ use self::narrow::{Event, Narrow, Overflow, Pending, Target};
 use self::obstacles::BoxArrays;
 use self::response::{Contacts, Effect, RestSets, Rules, Surface};
 use self::rest::{Support, Touch};
-use self::sweep::{CHUNK, REACH_STEPS, Sweep, path_box};
+use self::sweep::{CHUNK, Sweep, clear_of, path_box};
 use crate::engine::{BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation};
-use crate::plan::{DEFAULT_DT, Plan, stepped_broad_phase};
-use crate::scene::{Inelastic, Scene, SceneError};
+use crate::plan::{DEFAULT_DT, Plan, can_stick, stepped_broad_phase};
+use crate::scene::{Scene, SceneError};
 
 /// How often [`Observer::progress`] is called: every this many steps.
 const PROGRESS_EVERY: u64 = 256;
@@ -73,9 +73,9 @@ pub struct StepStats {
     /// gravity adds in one step, only a correction of the paths (not reported to the
     /// observer, not counted in [`Counters`]).
     pub resting: u64,
-    /// Broad-phase builds: when balls left their reach boxes (about every
-    /// 4 steps in a gas), every window in a periodic domain, and
-    /// every window cut short.
+    /// Broad-phase builds: when balls left their reach boxes (every few steps: see
+    /// `docs/stepped.md`), every window in a periodic domain, and every window cut
+    /// short.
     pub broad_builds: u64,
     /// Windows cut short: too many escapees, or a ball too fast for the periodic window.
     pub rebuilds: u64,
@@ -134,6 +134,21 @@ where
     escape_bound: usize,
 }
 
+/// A chunk's segment starts: positions, velocities, spins, times.
+type Segment<'a, T, const D: usize> = (
+    &'a mut [Vector<T, D>],
+    &'a mut [Vector<T, D>],
+    &'a mut [crate::Angular<T, D>],
+    &'a mut [T],
+);
+
+/// A chunk's state: positions, velocities, spins.
+type State<'a, T, const D: usize> = (
+    &'a mut [Vector<T, D>],
+    &'a mut [Vector<T, D>],
+    &'a mut [crate::Angular<T, D>],
+);
+
 /// How a window of the event loop ended.
 enum WindowEnd<T> {
     /// At its planned end.
@@ -156,18 +171,16 @@ where
     /// The first rule of [`Scene::validate`] the scene breaks; `--dt` if the step is not
     /// finite and positive in this precision; `--broad` for a broad phase that cannot
     /// serve a periodic border; `world.border` for a periodic border too small for its
-    /// balls (two ball diameters must fit in half a period); `world.inelastic` for stick
-    /// clusters, which this engine does not simulate yet.
+    /// balls (two ball diameters must fit in half a period); `world.inelastic` for a
+    /// scene whose balls can stick ([`can_stick`]): this engine does not simulate stuck
+    /// clusters.
     pub fn new(scene: &Scene<T, D>, plan: &Plan, direction: Direction) -> Result<Self, SceneError> {
         scene.validate()?;
         let n = scene.balls.len();
         if u32::try_from(n + scene.boxes.len()).is_err() {
             return Err(SceneError::new("balls", "more than 2^32 balls and boxes"));
         }
-        if scene.world.inelastic == Inelastic::Stick
-            && (scene.world.restitution == T::zero()
-                || scene.balls.iter().any(|b| b.restitution == Some(T::zero())))
-        {
+        if can_stick(scene) {
             return Err(SceneError::new(
                 "world.inelastic",
                 "\"stick\" clusters are not simulated by the stepped engine; use --engine event (2D) or inelastic = \"slide\"",
@@ -348,46 +361,54 @@ where
         let Ok(dt) = TimeStep::new(h) else {
             return;
         };
-        let b = &mut self.balls;
-        b.seg_x.copy_from_slice(&b.pos);
-        b.seg_v.copy_from_slice(&b.vel);
-        b.seg_w.copy_from_slice(&b.spin);
-        b.seg_t.fill(T::zero());
-        b.supported.fill(false);
         self.rest.clear();
         let stepper = &self.stepper;
-        let run = |pos: &mut [Vector<T, D>],
-                   vel: &mut [Vector<T, D>],
-                   spin: &mut [crate::Angular<T, D>],
+        // Per chunk: the segments start where the balls are, then the balls are stepped
+        // and the chords follow from where they end.
+        let run = |(start, (pos, vel, spin)): (Segment<'_, T, D>, State<'_, T, D>),
                    inverse_mass: &[T],
-                   start: &[Vector<T, D>],
-                   chord: &mut [Vector<T, D>]| {
+                   chord: &mut [Vector<T, D>],
+                   supported: &mut [bool]| {
+            let (seg_x, seg_v, seg_w, seg_t) = start;
+            seg_x.copy_from_slice(pos);
+            seg_v.copy_from_slice(vel);
+            seg_w.copy_from_slice(spin);
+            seg_t.fill(T::zero());
+            supported.fill(false);
             if let Ok(mut bodies) =
                 Bodies::new(pos, vel, inverse_mass).and_then(|bodies| bodies.with_spins(spin))
             {
                 stepper.step(&mut bodies, t0, dt);
             }
-            for ((c, p), x) in chord.iter_mut().zip(pos.iter()).zip(start) {
+            for ((c, p), x) in chord.iter_mut().zip(pos.iter()).zip(seg_x.iter()) {
                 *c = (p - x) / h;
             }
         };
+        let b = &mut self.balls;
         if parallel {
-            b.pos
+            b.seg_x
                 .par_chunks_mut(CHUNK)
+                .zip(b.seg_v.par_chunks_mut(CHUNK))
+                .zip(b.seg_w.par_chunks_mut(CHUNK))
+                .zip(b.seg_t.par_chunks_mut(CHUNK))
+                .zip(b.pos.par_chunks_mut(CHUNK))
                 .zip(b.vel.par_chunks_mut(CHUNK))
                 .zip(b.spin.par_chunks_mut(CHUNK))
                 .zip(b.inverse_mass.par_chunks(CHUNK))
-                .zip(b.seg_x.par_chunks(CHUNK))
                 .zip(b.chord.par_chunks_mut(CHUNK))
-                .for_each(|(((((p, v), w), m), x), c)| run(p, v, w, m, x, c));
+                .zip(b.supported.par_chunks_mut(CHUNK))
+                .for_each(|(((((((((x, v), w), t), p), u), s), m), c), f)| {
+                    run(((x, v, w, t), (p, u, s)), m, c, f);
+                });
         } else {
             run(
-                &mut b.pos,
-                &mut b.vel,
-                &mut b.spin,
+                (
+                    (&mut b.seg_x, &mut b.seg_v, &mut b.seg_w, &mut b.seg_t),
+                    (&mut b.pos, &mut b.vel, &mut b.spin),
+                ),
                 &b.inverse_mass,
-                &b.seg_x,
                 &mut b.chord,
+                &mut b.supported,
             );
         }
     }
@@ -426,6 +447,7 @@ where
             instant: T::lit(self.clock.dt * 1e-6),
         };
         let periodic_boxes = self.periodic.is_some() && self.boxes.len() > 0;
+        let entries = self.sweep.entries();
         let nboxes = self.boxes.len();
         let work = |c: usize, out: &mut Vec<Event<T, D>>| -> Result<(), Overflow> {
             out.clear();
@@ -446,9 +468,14 @@ where
                     }
                 }
             } else {
-                let c = c - pair_chunks;
-                for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
-                    push(narrow.ball_border(i, a))?;
+                let first = (c - pair_chunks) * CHUNK;
+                let last = (first + CHUNK).min(n);
+                for (i, entry) in (first..last).zip(&entries[first..last]) {
+                    // A ball whose entry is clear of the walls cannot reach one (an
+                    // escapee is predicted by query, walls included).
+                    if narrow.border.is_some_and(|border| !clear_of(entry, border)) {
+                        push(narrow.ball_border(i, a))?;
+                    }
                     if periodic_boxes {
                         for k in 0..nboxes {
                             push(narrow.ball_box(i, k, a))?;
@@ -830,7 +857,8 @@ where
                 let reach = if self.periodic.is_some() {
                     b - a
                 } else {
-                    (h - a) + h * T::from_count(REACH_STEPS as usize - 1)
+                    let steps = self.sweep.reach_steps(&self.balls, h, parallel);
+                    (h - a) + h * T::from_count(steps - 1)
                 };
                 self.sweep
                     .build(&self.balls, &self.boxes, a, reach, parallel);

@@ -3,10 +3,13 @@
 //!
 //! Each ball is entered as its **reach box**: the axis-aligned box around the ball of
 //! radius `r + max(|u|, ū) τ` centred at its position when the broad phase is built, with
-//! `u` its chord velocity, `ū` the scene's mean chord speed and `τ` the reach time:
-//! [`REACH_STEPS`] steps in open space, the window in a periodic domain. It holds the
-//! ball's path for that long, and every path that leaves from a point of the chord at no
-//! more than the same speed, so a ball that bounces back stays inside. Boxes (walls,
+//! `u` its chord velocity, `ū` the mean chord speed and `τ` the reach time. In open space
+//! `τ` is `K` steps, with `K` chosen at each build so that the mean ball travels half the
+//! mean radius in `τ` (`1 <= K <= 16`): slow scenes rebuild rarely, fast ones every step,
+//! and the boxes grow by about half a radius, which adds few pairs; in a periodic domain
+//! `τ` is the window. A box holds the ball's path for that long, and every path that
+//! leaves from a point of the chord at no more than the same speed, so a ball that
+//! bounces back stays inside. Boxes (walls,
 //! paddles) are entered as the box swept over the same time, except in a periodic domain,
 //! where boxes are tested against every ball with their periodic images (see `narrow`).
 //! carom-broad returns the overlapping pairs; the narrow phase computes a time of impact
@@ -36,9 +39,8 @@ use crate::plan::BroadChoice;
 /// Balls per parallel chunk of the data-parallel passes.
 pub(crate) const CHUNK: usize = 1024;
 
-/// How many steps of travel a reach box holds in open space: the broad phase is rebuilt
-/// about this often in a gas (more pairs to test per step, fewer builds).
-pub(crate) const REACH_STEPS: u32 = 4;
+/// The most steps of travel a reach box holds in open space.
+pub(crate) const MAX_REACH_STEPS: usize = 16;
 
 /// The broad phase and its buffers.
 pub(crate) struct Sweep<T: Real, const D: usize> {
@@ -50,6 +52,9 @@ pub(crate) struct Sweep<T: Real, const D: usize> {
     built: bool,
     /// The number of balls (volumes past it are boxes).
     balls: usize,
+    /// Per ball: the box its centre must stay in for its path to fit its entry (the
+    /// entry shrunk by the radius and a rounding allowance).
+    cores: Vec<Aabb<T, D>>,
     /// Whether each ball's path fits its entry at the start of a step (scratch).
     fits: Vec<bool>,
     /// Per-chunk sums (scratch).
@@ -89,6 +94,7 @@ where
             boxes_inside: periodic.is_none(),
             built: false,
             balls: n,
+            cores: Vec::with_capacity(n),
             fits: Vec::with_capacity(n),
             sums: Vec::new(),
             builds: 0,
@@ -131,12 +137,12 @@ where
         if self.built && self.boxes_fit(boxes, h) {
             let n = balls.len();
             self.fits.resize(n, true);
-            let volumes = &self.volumes;
+            let cores = &self.cores;
             fill(&mut self.fits, parallel, |i| {
-                contains(
-                    &volumes[i],
-                    &path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]),
-                )
+                let core = &cores[i];
+                [balls.seg_x[i], balls.pos[i]]
+                    .iter()
+                    .all(|p| (0..D).all(|k| core.min()[k] <= p[k] && p[k] <= core.max()[k]))
             });
             for (i, _) in self.fits.iter().enumerate().filter(|(_, fits)| !**fits) {
                 if self.escaped.len() >= escape_bound {
@@ -151,9 +157,23 @@ where
             }
             self.clear_escapees();
         }
-        let reach = h * T::from_count(REACH_STEPS as usize);
-        self.build(balls, boxes, T::zero(), reach, parallel);
+        let steps = self.reach_steps(balls, h, parallel);
+        self.build(balls, boxes, T::zero(), h * T::from_count(steps), parallel);
         &self.escaped
+    }
+
+    /// How many steps `K` a reach box should hold: the mean ball travels half the mean
+    /// radius in `K` steps (`1 <= K <= MAX_REACH_STEPS`).
+    pub(crate) fn reach_steps(&mut self, balls: &BallArrays<T, D>, h: T, parallel: bool) -> usize {
+        let n = T::from_count(balls.len().max(1));
+        let travel = chunked_sum(&balls.chord, parallel, &mut self.sums, Vector::norm) / n * h;
+        let radius = chunked_sum(&balls.radius, parallel, &mut self.sums, |r: &T| *r) / n;
+        let steps = (T::lit(0.5) * radius / travel).floor().to_f64();
+        if steps.is_finite() {
+            (steps as usize).clamp(1, MAX_REACH_STEPS)
+        } else {
+            MAX_REACH_STEPS
+        }
     }
 
     fn boxes_fit(&self, boxes: &BoxArrays<T, D>, h: T) -> bool {
@@ -191,6 +211,18 @@ where
             reach_box(&x, balls.radius[i], balls.chord[i].norm().max(mean) * reach)
         };
         fill(&mut self.volumes, parallel, entry);
+        self.cores
+            .resize(n, Aabb::new_unchecked(Vector::zeros(), Vector::zeros()));
+        let core = |i: usize| {
+            let x = balls.position_at(i, a);
+            let (r, travel) = (balls.radius[i], balls.chord[i].norm().max(mean) * reach);
+            // Any path box of a segment with both ends within `travel − δ` of `x` lies in
+            // the entry: δ covers path_box's own rounding allowance twice over.
+            let slack = T::lit(16.0) * T::EPSILON * (x.amax() + r + travel);
+            let half = Vector::<T, D>::repeat((travel - slack).max(T::zero()));
+            Aabb::new_unchecked(x - half, x + half)
+        };
+        fill(&mut self.cores, parallel, core);
         if self.boxes_inside {
             self.volumes
                 .extend((0..boxes.len()).map(|k| boxes.swept(k, a, a + reach)));
@@ -232,6 +264,11 @@ where
             self.escape_box[i] = Some(path);
         }
         self.escaped.len()
+    }
+
+    /// The balls' entries (then the boxes').
+    pub(crate) fn entries(&self) -> &[Aabb<T, D>] {
+        &self.volumes
     }
 
     /// The `k`-th escapee.
@@ -289,6 +326,12 @@ pub(crate) fn chunked_sum<X: Sync, T: Real>(
             .map(part)
             .fold(T::zero(), |sum, x| sum + x)
     }
+}
+
+/// Whether `entry` lies strictly inside `border`: a ball whose path is in it does not
+/// reach a wall.
+pub(crate) fn clear_of<T: Real, const D: usize>(entry: &Aabb<T, D>, border: &Border<T, D>) -> bool {
+    (0..D).all(|k| border.min()[k] < entry.min()[k] && entry.max()[k] < border.max()[k])
 }
 
 /// Whether `inner` lies in `outer`.

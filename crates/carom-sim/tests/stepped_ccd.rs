@@ -1,0 +1,334 @@
+//! Continuous collision detection: nothing passes through anything at any speed.
+//!
+//! Every scene here would tunnel without CCD: balls at up to 1e6 m/s cross thousands of
+//! times their size in one step. The references are closed forms: elastic head-on
+//! collisions (velocities exchanged, times of impact `gap / closing speed`), a ball
+//! bouncing between two parallel surfaces (a triangle wave), a paddle hitting a ball at
+//! rest (`(1 + e) u`), and a brute-force overlap check of every pair after every step.
+
+mod common;
+
+use carom_geometry::{Border, Obb};
+use carom_integrate::Integrator;
+use carom_math::{Real, Space};
+use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
+use carom_sim::scenes::gas::{GasParams, gas};
+use carom_sim::{Collision, Simulation};
+use common::{Recorder, states, stepped};
+use nalgebra::{Const, Vector2, Vector3};
+
+const DT: f64 = 1.0 / 600.0;
+
+/// Two balls of radius 0.1 at `x = ∓1` approaching at `±v`, masses `m0` and `m1`, no border.
+fn head_on<const D: usize>(v: f64, m0: f64, m1: f64) -> Scene<f64, D> {
+    let at = |x: f64| {
+        let mut p = nalgebra::SVector::<f64, D>::zeros();
+        p[0] = x;
+        p
+    };
+    Scene {
+        balls: vec![
+            BallSpec::new(at(-1.0), at(v), 0.1, m0),
+            BallSpec::new(at(1.0), at(-v), 0.1, m1),
+        ],
+        ..Scene::default()
+    }
+}
+
+fn check_head_on<T: Real, const D: usize>(v: f64, tolerance: f64)
+where
+    Const<D>: Space<T, D>,
+{
+    let s: Scene<T, D> = head_on::<D>(v, 1.0, 1.0).cast().unwrap();
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    let mut rec = Recorder::default();
+    // They meet at t = 1.8 / 2v and swap velocities; run to the end of the next step.
+    let t_hit = 1.8 / (2.0 * v);
+    let end = ((t_hit / DT).floor() + 1.0) * DT;
+    sim.advance_to(T::lit(end), &mut rec).unwrap();
+    assert_eq!(rec.collisions.len(), 1);
+    let Collision::BallBall { time, i: 0, j: 1 } = rec.collisions[0] else {
+        panic!("{:?}", rec.collisions[0]);
+    };
+    assert!((time.to_f64() - t_hit).abs() <= tolerance * t_hit);
+    let st = states(&sim);
+    let x0 = -0.1 - v * (end - t_hit);
+    assert!((st.pos[0][0].to_f64() - x0).abs() <= tolerance * x0.abs());
+    assert!((st.pos[1][0].to_f64() + x0).abs() <= tolerance * x0.abs());
+    assert!((st.vel[0][0].to_f64() + v).abs() <= tolerance * v);
+    assert!((st.vel[1][0].to_f64() - v).abs() <= tolerance * v);
+}
+
+#[test]
+fn balls_meeting_head_on_at_a_million_metres_per_second_bounce() {
+    for v in [1.0, 1e3, 1e6] {
+        check_head_on::<f64, 2>(v, 1e-12);
+        check_head_on::<f64, 3>(v, 1e-12);
+        check_head_on::<f32, 2>(v, 1e-5);
+        check_head_on::<f32, 3>(v, 1e-5);
+    }
+}
+
+#[test]
+fn a_light_fast_ball_bounces_off_a_heavy_one_at_mass_ratio_1e6() {
+    let s = head_on::<2>(1e6, 1.0, 1e6);
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    sim.advance_to(DT, &mut ()).unwrap();
+    let st = states(&sim);
+    // v0' = ((m0 − m1) v + 2 m1 (−v)) / (m0 + m1), v1' = (2 m0 v + (m1 − m0)(−v)) / (m0 + m1).
+    let (m0, m1, v) = (1.0, 1e6, 1e6);
+    let v0 = ((m0 - m1) * v - 2.0 * m1 * v) / (m0 + m1);
+    let v1 = (2.0 * m0 * v - (m1 - m0) * v) / (m0 + m1);
+    assert!((st.vel[0].x - v0).abs() < 1e-9 * v);
+    assert!((st.vel[1].x - v1).abs() < 1e-9 * v);
+    assert!(st.pos[1].x - st.pos[0].x > 0.2);
+}
+
+/// A ball of radius `r` moving along x at `v` from `x0` between a wall at `left` and a
+/// face at `right`: the centre bounces on `[left + r, right − r]` as a triangle wave.
+fn triangle_wave(x0: f64, v: f64, lo: f64, hi: f64, t: f64) -> f64 {
+    let span = hi - lo;
+    let u = (x0 - lo + v * t).rem_euclid(2.0 * span);
+    lo + if u <= span { u } else { 2.0 * span - u }
+}
+
+#[test]
+fn a_ball_trapped_between_a_box_and_a_wall_bounces_every_time_within_a_step() {
+    // Border x ∈ [−1, 1]; a box whose left face is at x = 0.4; the ball (r = 0.1) runs
+    // between x = −0.9 and x = 0.3 at 1e5 m/s: about 69 bounces per step of 1/600 s.
+    let v = 1e5;
+    let s = Scene {
+        world: World {
+            border: Some(BorderSpec {
+                border: Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0)).unwrap(),
+                restitution: 1.0,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls: vec![BallSpec::new(
+            Vector2::new(0.0, 0.0),
+            Vector2::new(v, 0.0),
+            0.1,
+            1.0,
+        )],
+        boxes: vec![BoxSpec {
+            shape: Obb::from_angle(Vector2::new(0.45, 0.0), Vector2::new(0.05, 0.5), 0.0).unwrap(),
+            vel: Vector2::zeros(),
+            restitution: 1.0,
+        }],
+        ..Scene::default()
+    };
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    let mut rec = Recorder::default();
+    for k in 1..=10 {
+        let t = f64::from(k) * DT;
+        sim.advance_to(t, &mut rec).unwrap();
+        let st = states(&sim);
+        let expected = triangle_wave(0.0, v, -0.9, 0.3, t);
+        // Each bounce rounds the position once (1e-16 of 1 m): 700 bounces stay far
+        // below 1e-9.
+        assert!(
+            (st.pos[0].x - expected).abs() < 1e-9,
+            "t = {t}: {:?} vs {expected}",
+            st.pos[0]
+        );
+        assert_eq!(st.pos[0].y, 0.0);
+        assert!((st.vel[0].x.abs() - v).abs() < 1e-6);
+    }
+    // Bounces: one each time the path reaches an end, 1.2 m apart.
+    let travelled = v * 10.0 * DT;
+    let expected = ((travelled - 0.3) / 1.2).floor() as usize + 1;
+    let walls = rec
+        .collisions
+        .iter()
+        .filter(|c| matches!(c, Collision::BallBorder { .. }))
+        .count();
+    let box_hits = rec.collisions.len() - walls;
+    assert_eq!(walls + box_hits, expected);
+    assert!(walls.abs_diff(box_hits) <= 1);
+    assert!(sim.stats().max_contacts_in_step >= 60);
+}
+
+#[test]
+fn a_ball_at_a_million_metres_per_second_stays_in_the_border_and_out_of_thin_boxes() {
+    // A thin rotated plate (1 mm thick) across the middle of a 3D box, and a ball shot
+    // at it at 1e6 m/s in a slanted direction: it must stay on its own side forever.
+    let plate = Obb::from_axis_angle(
+        Vector3::new(0.0, 0.0, 0.0),
+        Vector3::new(0.0005, 2.0, 2.0),
+        Vector3::new(0.0, 0.2, 0.3),
+    )
+    .unwrap();
+    let normal = plate.axis(0);
+    let s = Scene {
+        world: World {
+            border: Some(BorderSpec {
+                border: Border::new(Vector3::repeat(-1.0), Vector3::repeat(1.0)).unwrap(),
+                restitution: 1.0,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls: vec![BallSpec::new(
+            -normal * 0.5,
+            Vector3::new(0.9, 0.3, -0.2).normalize() * 1e6,
+            0.05,
+            1.0,
+        )],
+        boxes: vec![BoxSpec {
+            shape: plate,
+            vel: Vector3::zeros(),
+            restitution: 1.0,
+        }],
+        ..Scene::default()
+    };
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    for k in 1..=20 {
+        sim.advance_to(f64::from(k) * DT, &mut ()).unwrap();
+        let p = states(&sim).pos[0];
+        assert!(
+            normal.dot(&p) <= -(0.0005 + 0.05) + 1e-9,
+            "step {k}: the ball crossed the plate: {p:?}"
+        );
+        assert!(
+            p.amax() <= 1.0 - 0.05 + 1e-9,
+            "step {k}: left the border: {p:?}"
+        );
+        assert!((states(&sim).vel[0].norm() - 1e6).abs() < 1e-3);
+    }
+    assert!(sim.counters().ball_box > 100 && sim.counters().ball_border > 100);
+}
+
+#[test]
+fn a_paddle_sends_a_ball_at_rest_off_at_one_plus_e_times_its_speed() {
+    for (u, e) in [(3.0_f64, 1.0), (3.0, 0.6), (200.0, 0.85), (-50.0, 0.0)] {
+        let s = Scene {
+            balls: vec![BallSpec::new(
+                Vector2::zeros(),
+                Vector2::zeros(),
+                0.02,
+                0.0027,
+            )],
+            boxes: vec![BoxSpec {
+                shape: Obb::from_angle(
+                    Vector2::new(-0.5 * u.signum(), 0.0),
+                    Vector2::new(0.01, 0.1),
+                    0.0,
+                )
+                .unwrap(),
+                vel: Vector2::new(u, 0.0),
+                restitution: e,
+            }],
+            ..Scene::default()
+        };
+        let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+        let mut rec = Recorder::default();
+        sim.advance_to(1.0 / u.abs() + 2.0 * DT, &mut rec).unwrap();
+        let v = states(&sim).vel[0];
+        if e > 0.0 {
+            assert_eq!(rec.collisions.len(), 1, "u = {u}, e = {e}");
+        }
+        assert!(
+            (v.x - (1.0 + e) * u).abs() < 1e-9 * u.abs(),
+            "u = {u}, e = {e}: {v:?}"
+        );
+        assert_eq!(v.y, 0.0);
+        // The paddle hit at the time its face reached the ball: 0.5 − 0.01 − 0.02 = 0.47 m.
+        if let Some(Collision::BallBox { time, i: 0, k: 0 }) = rec.collisions.first() {
+            assert!((time - 0.47 / u.abs()).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn a_paddle_driven_from_rust_hits_at_its_scripted_speed() {
+    // The paddle waits, then is given 40 m/s for the steps it swings, then stops.
+    let s = Scene {
+        balls: vec![BallSpec::new(
+            Vector2::zeros(),
+            Vector2::zeros(),
+            0.02,
+            0.0027,
+        )],
+        boxes: vec![BoxSpec {
+            shape: Obb::from_angle(Vector2::new(-0.2, 0.0), Vector2::new(0.01, 0.1), 0.3).unwrap(),
+            vel: Vector2::zeros(),
+            restitution: 0.9,
+        }],
+        ..Scene::default()
+    };
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    let mut rec = Recorder::default();
+    sim.advance_to(0.1, &mut rec).unwrap();
+    assert_eq!(sim.box_center(0), Some(Vector2::new(-0.2, 0.0)));
+    sim.set_box_velocity(0, Vector2::new(40.0, 0.0)).unwrap();
+    sim.advance_to(0.1 + 6.0 * DT, &mut rec).unwrap();
+    sim.set_box_velocity(0, Vector2::zeros()).unwrap();
+    sim.advance_to(0.2, &mut rec).unwrap();
+    assert_eq!(rec.collisions.len(), 1);
+    // The paddle face is tilted by 0.3 rad: the ball leaves along the face normal with
+    // (1 + e) times the paddle's normal speed.
+    let normal = Vector2::new(0.3_f64.cos(), 0.3_f64.sin());
+    let v = states(&sim).vel[0];
+    assert!(
+        (v - normal * (1.9 * 40.0 * normal.x)).norm() < 1e-9,
+        "{v:?}"
+    );
+    let moved = sim.box_center(0).unwrap() - Vector2::new(-0.2, 0.0);
+    assert!((moved - Vector2::new(40.0 * 6.0 * DT, 0.0)).norm() < 1e-12);
+    assert!(sim.pipeline().iter().any(|p| p == "kinematic-boxes"));
+    assert_eq!(
+        sim.set_box_velocity(3, Vector2::zeros())
+            .unwrap_err()
+            .to_string(),
+        "boxes[3]: no such box: the scene has 1"
+    );
+    assert_eq!(
+        sim.set_box_velocity(0, Vector2::new(f64::NAN, 0.0))
+            .unwrap_err()
+            .field,
+        "boxes[0].vel[0]"
+    );
+}
+
+/// The deepest overlap of any two balls or of a ball with the border.
+fn deepest_overlap(s: &Scene<f64, 2>, pos: &[Vector2<f64>]) -> f64 {
+    let b = s.world.border.unwrap().border;
+    let mut worst = 0.0_f64;
+    for i in 0..pos.len() {
+        let r = s.balls[i].radius;
+        worst = worst.max((b.min() - pos[i]).add_scalar(r).max());
+        worst = worst.max((pos[i] - b.max()).add_scalar(r).max());
+        for j in i + 1..pos.len() {
+            worst = worst.max(r + s.balls[j].radius - (pos[i] - pos[j]).norm());
+        }
+    }
+    worst
+}
+
+#[test]
+fn a_fast_dense_gas_never_overlaps() {
+    // 300 balls at packing fraction 0.3 with thermal speeds of 1e4 m/s: each ball
+    // crosses the box many times per step of 1/60 s and collides thousands of times.
+    let s = gas::<2>(&GasParams {
+        n: 300,
+        fraction: 0.3,
+        speed: 1e4,
+        seed: 5,
+        ..GasParams::default()
+    })
+    .unwrap();
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, 1.0 / 60.0);
+    let e0 = carom_sim::observe::energy(&s, &states(&sim));
+    for k in 1..=5 {
+        sim.advance_to(f64::from(k) / 60.0, &mut ()).unwrap();
+        let st = states(&sim);
+        let overlap = deepest_overlap(&s, &st.pos);
+        assert!(overlap < 1e-9, "step {k}: overlap {overlap:e}");
+        let e = carom_sim::observe::energy(&s, &st);
+        assert!((e - e0).abs() < 1e-9 * e0, "step {k}: energy {e0} -> {e}");
+    }
+    assert!(sim.stats().max_contacts_in_step > 1000);
+    assert_eq!(sim.stats().capped_steps, 0);
+}
