@@ -66,36 +66,15 @@ impl RapierScene {
             .iter()
             .map(|b| b.restitution.unwrap_or(s.world.restitution))
             .collect();
-        let (e_lo, e_hi) = ball_e
-            .iter()
-            .fold((1.0_f64, 0.0_f64), |(lo, hi), &e| (lo.min(e), hi.max(e)));
-        let wall = |e: f64| -> Result<CoefficientCombineRule, Unsupported> {
-            if e <= e_lo {
-                Ok(CoefficientCombineRule::Min)
-            } else if e >= e_hi {
-                Ok(CoefficientCombineRule::Max)
-            } else {
-                Err(Unsupported(
-                    "a wall or box restitution between the balls' smallest and largest",
-                ))
-            }
-        };
-        let surface = |c: ColliderBuilder, e: f64, rule| {
-            c.restitution(e as f32)
-                .restitution_combine_rule(rule)
-                .friction(0.0)
-                .friction_combine_rule(CoefficientCombineRule::Min)
-        };
-
+        let surfaces = Surfaces::new(&ball_e);
         let g = s.world.gravity;
         let mut world = PhysicsWorld {
             gravity: Vector::new(g.x as f32, g.y as f32),
             ..PhysicsWorld::default()
         };
         world.integration_parameters.dt = dt as f32;
-
         if let Some(border) = s.world.border {
-            let rule = wall(border.restitution)?;
+            let rule = surfaces.wall_rule(border.restitution)?;
             let (lo, hi) = (border.border.min(), border.border.max());
             let (cx, cy) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
             let (hx, hy) = (0.5 * (hi.x - lo.x), 0.5 * (hi.y - lo.y));
@@ -118,7 +97,7 @@ impl RapierScene {
             }
         }
         for b in &s.boxes {
-            let rule = wall(b.restitution)?;
+            let rule = surfaces.wall_rule(b.restitution)?;
             let (c, h) = (b.shape.center(), b.shape.half_extents());
             let body = if b.vel == nalgebra::Vector2::zeros() {
                 RigidBodyBuilder::fixed()
@@ -207,4 +186,42 @@ impl RapierScene {
             p.dt, p.num_solver_iterations, p.max_ccd_substeps
         )
     }
+}
+
+/// The balls' range of restitution coefficients, which decides a wall's combine rule.
+struct Surfaces {
+    /// The smallest ball coefficient.
+    lowest: f64,
+    /// The largest ball coefficient.
+    highest: f64,
+}
+
+impl Surfaces {
+    fn new(ball_restitution: &[f64]) -> Self {
+        let (lowest, highest) = ball_restitution
+            .iter()
+            .fold((1.0_f64, 0.0_f64), |(lo, hi), &e| (lo.min(e), hi.max(e)));
+        Self { lowest, highest }
+    }
+
+    /// The rule that gives a ball–wall contact exactly the wall's coefficient `e`.
+    fn wall_rule(&self, e: f64) -> Result<CoefficientCombineRule, Unsupported> {
+        if e <= self.lowest {
+            Ok(CoefficientCombineRule::Min)
+        } else if e >= self.highest {
+            Ok(CoefficientCombineRule::Max)
+        } else {
+            Err(Unsupported(
+                "a wall or box restitution between the balls' smallest and largest",
+            ))
+        }
+    }
+}
+
+/// A collider with restitution `e` combined by `rule`, frictionless.
+fn surface(c: ColliderBuilder, e: f64, rule: CoefficientCombineRule) -> ColliderBuilder {
+    c.restitution(e as f32)
+        .restitution_combine_rule(rule)
+        .friction(0.0)
+        .friction_combine_rule(CoefficientCombineRule::Min)
 }
