@@ -308,6 +308,10 @@ fn bench_random_boxes(c: &mut Criterion) {
 }
 
 fn criterion_benches(c: &mut Criterion) {
+    if let Ok(spec) = std::env::var("CAROM_BENCH_PROFILE") {
+        profile(&spec);
+        return;
+    }
     if std::env::var_os("CAROM_BENCH_TABLE").is_some() {
         print_table();
         return;
@@ -465,6 +469,66 @@ fn print_table() {
     }
     table_dim::<2>(&mut || Box::new(Parry2::default()));
     table_dim::<3>(&mut || Box::new(Parry3::default()));
+}
+
+// ---------------------------------------------------------------------------------
+// profile mode
+
+/// Runs a fixed number of frames of one case, for instruction counts under
+/// `valgrind --tool=callgrind` (or cachegrind): `CAROM_BENCH_PROFILE=phase/case/frames`,
+/// the case being `boxes` (Terdiman's 10,000 random boxes) or `3D-uniform0.1-1000000-coherent`.
+fn profile(spec: &str) {
+    let parts: Vec<&str> = spec.split('/').collect();
+    let [name, case, frames] = parts[..] else {
+        panic!("CAROM_BENCH_PROFILE=phase/case/frames, e.g. sap/boxes/20");
+    };
+    let frames: usize = frames.parse().expect("frame count");
+    let mut out = Vec::new();
+    if case == "boxes" {
+        let a = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 1);
+        let b = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 2);
+        let mut phase = make_phase::<3>(name, false);
+        for k in 0..frames {
+            let s = if k.is_multiple_of(2) { &a } else { &b };
+            frame(phase.as_mut(), s.aabbs(), None, &mut out);
+        }
+        println!("{} pairs", out.len());
+        return;
+    }
+    let fields: Vec<&str> = case.split('-').collect();
+    let [dim, dist, n, mode] = fields[..] else {
+        panic!("case: dim-scene-n-mode, e.g. 3D-uniform0.1-1000000-coherent");
+    };
+    let dist = match dist {
+        "clustered" => Distribution::Clustered,
+        "mixed" => Distribution::Mixed,
+        d => Distribution::Uniform(d.trim_start_matches("uniform").parse().expect("fraction")),
+    };
+    let n: usize = n.parse().expect("ball count");
+    let coherent = mode == "coherent";
+    let threads = std::env::var("CAROM_BENCH_THREADS").map_or(1, |t| t.parse().unwrap_or(1));
+    let p = pool(threads);
+    let pool = (threads > 1).then_some(&p);
+    macro_rules! run {
+        ($d:literal) => {{
+            let frames_of = Frames::<$d>::new(dist, n, coherent);
+            let mut phase = make_phase::<$d>(name, coherent);
+            for k in 0..frames {
+                frame(
+                    phase.as_mut(),
+                    frames_of.frames[k % 2].balls(),
+                    pool,
+                    &mut out,
+                );
+            }
+        }};
+    }
+    if dim == "2D" {
+        run!(2)
+    } else {
+        run!(3)
+    }
+    println!("{} pairs", out.len());
 }
 
 criterion_group!(benches, criterion_benches);

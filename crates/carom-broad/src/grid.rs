@@ -41,7 +41,7 @@ use carom_geometry::{Aabb, Border};
 use carom_math::{Real, Vector};
 
 use crate::pairs::{Emitter, PairBuffers};
-use crate::par::{extend_indexed, map_in_place, max_indexed};
+use crate::par::{extend_indexed, fold_indexed, try_map_in_place};
 use crate::radix::{entry, entry_id, entry_key, insertion_sort_bounded, radix_sort_by_key};
 use crate::sweep::{SortPolicy, SweepCore};
 use crate::volumes::{Proxy, Store, ensure_ratio, overlap, sampled_median};
@@ -195,6 +195,52 @@ fn all_offsets<const D: usize>() -> Vec<Cell<D>> {
         .collect()
 }
 
+/// What the cell geometry needs from the regular volumes: their largest extent, the
+/// largest `|centre|_∞ + extent` (the coordinate scale of roundings) and the bounding box
+/// of their centres.
+#[derive(Clone, Copy, Debug)]
+struct RegularBounds<const D: usize> {
+    width: f64,
+    scale: f64,
+    lo: [f64; D],
+    hi: [f64; D],
+}
+
+impl<const D: usize> RegularBounds<D> {
+    fn empty() -> Self {
+        Self {
+            width: 0.0,
+            scale: 0.0,
+            lo: [f64::INFINITY; D],
+            hi: [f64::NEG_INFINITY; D],
+        }
+    }
+
+    /// These bounds grown to cover a volume with largest edge `extent`.
+    #[inline]
+    fn with<T: Real>(mut self, p: &Proxy<T, D>, extent: f64) -> Self {
+        self.width = self.width.max(extent);
+        let mut amax = 0.0_f64;
+        for k in 0..D {
+            let c = p.center[k].to_f64();
+            amax = amax.max(c.abs());
+            self.lo[k] = self.lo[k].min(c);
+            self.hi[k] = self.hi[k].max(c);
+        }
+        self.scale = self.scale.max(amax + extent);
+        self
+    }
+
+    fn merge(a: Self, b: Self) -> Self {
+        Self {
+            width: a.width.max(b.width),
+            scale: a.scale.max(b.scale),
+            lo: core::array::from_fn(|k| a.lo[k].min(b.lo[k])),
+            hi: core::array::from_fn(|k| a.hi[k].max(b.hi[k])),
+        }
+    }
+}
+
 /// One regular volume in bucket order.
 #[derive(Clone, Copy, Debug)]
 struct Entry<T: Real, const D: usize> {
@@ -220,6 +266,8 @@ pub struct UniformGrid<T: Real, const D: usize> {
     keys: Vec<u64>,
     scratch: Vec<u64>,
     counts: Vec<usize>,
+    /// Per volume: its largest edge length.
+    extents: Vec<f64>,
     /// Per volume: `true` if it is in the cells this frame.
     in_cells: Vec<bool>,
     /// Per volume: its bucket, or `u32::MAX` when it is not in the cells.
@@ -259,6 +307,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             keys: Vec::new(),
             scratch: Vec::new(),
             counts: Vec::new(),
+            extents: Vec::new(),
             in_cells: Vec::new(),
             bucket_of: Vec::new(),
             regular: Vec::new(),
@@ -323,8 +372,9 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
 
     /// Chooses the cell geometry for the regular volumes, or `None` when there is no
     /// usable grid (no regular volume, or a periodic box under 3 cells wide).
-    fn choose_geometry(&self, cell_width: f64, scale: f64) -> Option<Geometry<D>> {
+    fn choose_geometry(&self, bounds: &RegularBounds<D>, scale: f64) -> Option<Geometry<D>> {
         let n = self.regular.len();
+        let cell_width = bounds.width;
         if n == 0 {
             return None;
         }
@@ -359,15 +409,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             }
             layout => {
                 let hashed = matches!(layout, GridLayout::Hashed);
-                let mut lo = [f64::INFINITY; D];
-                let mut hi = [f64::NEG_INFINITY; D];
-                for &i in &self.regular {
-                    let c = self.store.proxies[i as usize].center;
-                    for k in 0..D {
-                        lo[k] = lo[k].min(c[k].to_f64());
-                        hi[k] = hi[k].max(c[k].to_f64());
-                    }
-                }
+                let (lo, hi) = (bounds.lo, bounds.hi);
                 let span = (0..D).fold(0.0_f64, |s, k| s.max(hi[k] - lo[k]));
                 width = width.max(span / MAX_CELLS_PER_AXIS);
                 // Dense grids get an empty padding cell on each side, so that every
@@ -671,27 +713,33 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         let n = self.store.len();
         let proxies = &self.store.proxies;
 
-        // Regular volumes (in the cells) and oversized ones.
-        let threshold = self.oversize_ratio
-            * sampled_median(n, |i| proxies[i].extent().to_f64(), &mut self.selection);
-        let regular = |i: usize| proxies[i].extent().to_f64() <= threshold;
+        // Regular volumes (in the cells) and oversized ones, from each volume's largest
+        // edge, computed once.
+        self.extents.clear();
+        extend_indexed(&mut self.extents, n, parallel, |i| {
+            proxies[i].extent().to_f64()
+        });
+        let extents = &self.extents;
+        let threshold =
+            self.oversize_ratio * sampled_median(n, |i| extents[i], &mut self.selection);
         self.in_cells.clear();
-        extend_indexed(&mut self.in_cells, n, parallel, regular);
-        let cell_width = max_indexed(n, parallel, |i| {
-            if regular(i) {
-                proxies[i].extent().to_f64()
-            } else {
-                0.0
-            }
-        });
-        let scale = max_indexed(n, parallel, |i| {
-            let p = &proxies[i];
-            if regular(i) {
-                p.center.amax().to_f64() + p.extent().to_f64()
-            } else {
-                0.0
-            }
-        });
+        extend_indexed(&mut self.in_cells, n, parallel, |i| extents[i] <= threshold);
+        // One pass over the regular volumes for the cell width, the coordinate scale and
+        // the bounding box of the centres (maxima and minima: exact in any order).
+        let in_cells = &self.in_cells;
+        let bounds = fold_indexed(
+            n,
+            parallel,
+            RegularBounds::empty,
+            |b, i| {
+                if in_cells[i] {
+                    b.with(&proxies[i], extents[i])
+                } else {
+                    b
+                }
+            },
+            RegularBounds::merge,
+        );
         self.regular.clear();
         self.oversized.clear();
         for (i, &inside) in self.in_cells.iter().enumerate() {
@@ -701,8 +749,8 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                 self.oversized.push(i as u32);
             }
         }
-        let scale = scale.max(scale_floor);
-        self.geometry = self.choose_geometry(cell_width, scale);
+        let scale = bounds.scale.max(scale_floor);
+        self.geometry = self.choose_geometry(&bounds, scale);
         if self.geometry.is_none() {
             self.oversized.clear();
             self.oversized.extend(0..n as u32);
@@ -750,18 +798,14 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         // The previous keys name exactly this frame's regular volumes when there are as
         // many and each is regular (coarser levels renumber their volumes every frame,
         // so an index may also be out of range).
-        let same_set = self.keys.len() == regular
-            && self.keys.iter().all(|&e| {
-                bucket_of
-                    .get(entry_id(e) as usize)
-                    .is_some_and(|&b| b != u32::MAX)
-            });
-        let coherent = same_set && {
-            map_in_place(&mut self.keys, parallel, |e| {
-                entry(bucket_of[entry_id(e) as usize], entry_id(e))
-            });
-            insertion_sort_bounded(&mut self.keys, 4 * regular)
-        };
+        let coherent = self.keys.len() == regular
+            && try_map_in_place(&mut self.keys, parallel, |e| {
+                match bucket_of.get(entry_id(e) as usize) {
+                    Some(&b) if b != u32::MAX => Some(entry(b, entry_id(e))),
+                    _ => None,
+                }
+            })
+            && insertion_sort_bounded(&mut self.keys, 4 * regular);
         if !coherent {
             self.keys.clear();
             let ids = &self.regular;

@@ -212,8 +212,10 @@ impl<T: Real, const D: usize> Proxy<T, D> {
     }
 
     /// The largest edge length of the box.
+    #[inline]
     pub(crate) fn extent(&self) -> T {
-        self.aabb.extents().max()
+        let (lo, hi) = (self.aabb.min(), self.aabb.max());
+        (0..D).fold(T::zero(), |m, k| m.max(hi[k] - lo[k]))
     }
 }
 
