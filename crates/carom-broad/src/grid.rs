@@ -162,6 +162,59 @@ fn floor_to_i64(x: f64) -> i64 {
     if (t as f64) > x { t - 1 } else { t }
 }
 
+/// Fills `start` (resized to `buckets + 1`) so that `start[b]` is the first position in
+/// the sorted `keys` whose bucket is `>= b` (`keys.len()` past the last one): one
+/// sequential pass, or, on the rayon pool, one per chunk of keys, each writing the
+/// disjoint run of `start` that its keys determine (so the result is the same).
+#[cfg_attr(not(feature = "parallel"), allow(unused_variables))]
+fn fill_starts(start: &mut Vec<u32>, buckets: usize, keys: &[u64], parallel: bool) {
+    start.resize(buckets + 1, 0);
+    let n = keys.len();
+    // Chunk [p, q) of the keys writes start[x] for x from (the bucket of key p − 1) + 1
+    // up to the bucket of key q − 1, and the last chunk the rest of the array too.
+    let fill = |run: &mut [u32], first: usize, p: usize, q: usize| {
+        let mut b = first;
+        for (k, &e) in keys[p..q].iter().enumerate() {
+            // Keys of a bucket already started (here or in the previous chunk) add nothing.
+            let end = entry_key(e) as usize + 1;
+            if end > b {
+                run[b - first..end - first].fill((p + k) as u32);
+                b = end;
+            }
+        }
+        run[b - first..].fill(q as u32);
+    };
+    let first_of = |p: usize| {
+        if p == 0 {
+            0
+        } else {
+            entry_key(keys[p - 1]) as usize + 1
+        }
+    };
+    #[cfg(feature = "parallel")]
+    if parallel && n >= crate::par::MIN_PARALLEL {
+        use rayon::prelude::*;
+        let chunks = crate::parallel_chunks();
+        let mut runs = Vec::with_capacity(chunks);
+        let mut rest = start.as_mut_slice();
+        for c in 0..chunks {
+            let range = crate::chunk_range(c, chunks, n);
+            let (from, to) = (first_of(range.start), first_of(range.end));
+            let (run, tail) = if c + 1 == chunks {
+                (core::mem::take(&mut rest), &mut [][..])
+            } else {
+                rest.split_at_mut(to - from)
+            };
+            runs.push((run, from, range));
+            rest = tail;
+        }
+        runs.into_par_iter()
+            .for_each(|(run, from, range)| fill(run, from, range.start, range.end));
+        return;
+    }
+    fill(start, 0, 0, n);
+}
+
 /// The forward half of the neighbour offsets: those whose last non-zero component is
 /// positive (4 in 2D, 13 in 3D). With the cell itself they visit each adjacent pair of
 /// cells once.
@@ -814,15 +867,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             });
             radix_sort_by_key(&mut self.keys, &mut self.scratch, &mut self.counts);
         }
-        // start[b] = the first sorted position whose bucket is >= b (sequential fill).
-        self.start.resize(g.buckets + 1, 0);
-        let mut b = 0;
-        for (k, &e) in self.keys.iter().enumerate() {
-            let bucket = entry_key(e) as usize;
-            self.start[b..=bucket].fill(k as u32);
-            b = bucket + 1;
-        }
-        self.start[b..].fill(regular as u32);
+        fill_starts(&mut self.start, g.buckets, &self.keys, parallel);
         let (keys, store) = (&self.keys, &self.store);
         extend_indexed(&mut self.entries, regular, parallel, |k| {
             let id = entry_id(keys[k]);
@@ -960,6 +1005,41 @@ mod tests {
         let mut pairs = Vec::new();
         grid.pairs(&mut pairs);
         assert_eq!(pairs, expected);
+    }
+
+    #[test]
+    #[cfg(feature = "parallel")]
+    fn start_fill_is_the_same_sequentially_and_in_parallel() {
+        // Sorted keys with runs that straddle chunk boundaries (dense buckets) and
+        // long gaps (sparse ones), above the size where the fill goes parallel.
+        for (n, buckets) in [(20_000usize, 3_000usize), (20_000, 200_000), (9_000, 1)] {
+            let mut state = n as u64 ^ buckets as u64;
+            let mut keys: Vec<u64> = (0..n as u32)
+                .map(|id| {
+                    state = state
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    entry(((state >> 33) % buckets as u64) as u32, id)
+                })
+                .collect();
+            keys.sort_unstable();
+            // The definition: the first position whose bucket is >= b.
+            let expected: Vec<u32> = (0..=buckets)
+                .map(|b| keys.partition_point(|&e| (entry_key(e) as usize) < b) as u32)
+                .collect();
+            let mut start = vec![7; 5];
+            fill_starts(&mut start, buckets, &keys, false);
+            assert_eq!(start, expected);
+            for threads in [1, 2, 3] {
+                let mut start = Vec::new();
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| fill_starts(&mut start, buckets, &keys, true));
+                assert_eq!(start, expected, "{threads} threads");
+            }
+        }
     }
 
     #[test]

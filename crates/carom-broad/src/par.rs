@@ -7,7 +7,7 @@
 
 /// Below this many elements a pass stays on the calling thread.
 #[cfg(feature = "parallel")]
-const MIN_PARALLEL: usize = 8192;
+pub(crate) const MIN_PARALLEL: usize = 8192;
 
 /// Appends `f(0), …, f(n − 1)` to `v`, in order.
 #[cfg_attr(not(feature = "parallel"), allow(unused_variables))]
