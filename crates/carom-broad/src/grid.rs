@@ -13,8 +13,11 @@
 //!   volumes two cells apart, even at `1e6` from the origin.
 //! * **Bucketing.** `(bucket, index)` keys are radix-sorted, or insertion-sorted from the
 //!   previous frame's order when the frame is coherent; `start[bucket]` is then filled
-//!   in one sequential pass and the volumes are gathered in bucket order. No per-cell
-//!   `Vec`, and no random scatter over an array the size of the grid.
+//!   in one pass over the sorted keys (on the rayon pool: disjoint runs of `start`, one
+//!   per chunk of keys) and the volumes are gathered in bucket order. No per-cell
+//!   `Vec`, and no random scatter over an array the size of the grid. Each volume's
+//!   largest edge is computed once; the cell width, the coordinate scale and the
+//!   bounding box of the centres come from one fused pass over the volumes.
 //! * **Oversized volumes** stay out of the cells. From 32 of them on they form a coarser
 //!   level: a grid of the same layout over just them, with its own median and cell size
 //!   (and, recursively, its own coarser level; each level at least halves the count, so
@@ -77,6 +80,11 @@ struct Geometry<const D: usize> {
 }
 
 impl<const D: usize> Geometry<D> {
+    /// `true` for the dense layout (open space, buckets are cells).
+    fn is_dense(&self) -> bool {
+        !self.hashed && !self.periodic
+    }
+
     /// The cell of a point.
     #[inline]
     fn cell(&self, p: &[f64; D]) -> Cell<D> {
@@ -298,7 +306,6 @@ impl<const D: usize> RegularBounds<D> {
 #[derive(Clone, Copy, Debug)]
 struct Entry<T: Real, const D: usize> {
     proxy: Proxy<T, D>,
-    cell: Cell<D>,
     /// The caller's index (levels hold subsets; see `Store::gid`).
     id: u32,
 }
@@ -315,6 +322,10 @@ pub struct UniformGrid<T: Real, const D: usize> {
     reach: f64,
     start: Vec<u32>,
     entries: Vec<Entry<T, D>>,
+    /// The cell of each entry, for the hashed layout (where a bucket can hold several
+    /// cells) and the periodic one (whose search wraps cell coordinates); empty for the
+    /// dense layout, whose buckets are its cells.
+    cells: Vec<Cell<D>>,
     /// Sorted `(bucket, index)` keys of the regular volumes (kept for the next frame).
     keys: Vec<u64>,
     scratch: Vec<u64>,
@@ -357,6 +368,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             reach: 0.0,
             start: Vec::new(),
             entries: Vec::new(),
+            cells: Vec::new(),
             keys: Vec::new(),
             scratch: Vec::new(),
             counts: Vec::new(),
@@ -519,7 +531,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                     });
                     let bucket = g.bucket(&cell);
                     for m in self.start[bucket] as usize..self.start[bucket + 1] as usize {
-                        if self.entries[m].cell == cell {
+                        if !g.hashed || self.cells[m] == cell {
                             f(m);
                         }
                     }
@@ -544,7 +556,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
     fn search(&self, c: usize, chunks: usize, emit: &mut Emitter<'_>) {
         let regular = crate::chunk_range(c, chunks, self.entries.len());
         match &self.geometry {
-            Some(g) if !g.hashed && !g.periodic => self.search_dense(g, regular.clone(), emit),
+            Some(g) if g.is_dense() => self.search_dense(g, regular.clone(), emit),
             Some(g) => self.search_general(g, regular.clone(), emit),
             None => {}
         }
@@ -586,9 +598,9 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                     continue;
                 };
                 let bucket = g.bucket(&n);
-                for e in &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
-                {
-                    if e.cell == n {
+                for m in self.start[bucket] as usize..self.start[bucket + 1] as usize {
+                    if !g.hashed || self.cells[m] == n {
+                        let e = &self.entries[m];
                         f(&e.proxy, e.id);
                     }
                 }
@@ -652,21 +664,22 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
     ) {
         let (balls, period) = (self.store.balls, self.store.period.as_ref());
         for k in regular {
-            let a = &self.entries[k];
-            let end = self.start[g.bucket(&a.cell) + 1] as usize;
-            for b in &self.entries[k + 1..end] {
-                if b.cell == a.cell && overlap(&a.proxy, &b.proxy, balls, period) {
+            let (a, a_cell) = (&self.entries[k], &self.cells[k]);
+            let end = self.start[g.bucket(a_cell) + 1] as usize;
+            for m in k + 1..end {
+                let b = &self.entries[m];
+                if self.cells[m] == *a_cell && overlap(&a.proxy, &b.proxy, balls, period) {
                     emit.push(a.id, b.id);
                 }
             }
             for offset in &self.offsets {
-                let Some(cell) = g.neighbour(&a.cell, offset) else {
+                let Some(cell) = g.neighbour(a_cell, offset) else {
                     continue;
                 };
                 let bucket = g.bucket(&cell);
-                for b in &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
-                {
-                    if b.cell == cell && overlap(&a.proxy, &b.proxy, balls, period) {
+                for m in self.start[bucket] as usize..self.start[bucket + 1] as usize {
+                    let b = &self.entries[m];
+                    if self.cells[m] == cell && overlap(&a.proxy, &b.proxy, balls, period) {
                         emit.push(a.id, b.id);
                     }
                 }
@@ -816,6 +829,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         };
 
         self.entries.clear();
+        self.cells.clear();
         self.start.clear();
         match self.geometry {
             Some(g) => self.sort_into_cells(&g, parallel),
@@ -873,10 +887,14 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             let id = entry_id(keys[k]);
             Entry {
                 proxy: proxies[id as usize],
-                cell: cell_of(id),
                 id: store.gid(id),
             }
         });
+        if !g.is_dense() {
+            extend_indexed(&mut self.cells, regular, parallel, |k| {
+                cell_of(entry_id(keys[k]))
+            });
+        }
     }
 
     /// Puts the oversized volumes in a coarser level when there are enough of them (and
