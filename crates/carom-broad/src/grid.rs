@@ -44,7 +44,7 @@ use carom_geometry::{Aabb, Border};
 use carom_math::{Real, Vector};
 
 use crate::pairs::{Emitter, PairBuffers};
-use crate::par::{extend_indexed, fold_indexed, try_map_in_place};
+use crate::par::{fill_indexed, fold_indexed, try_map_in_place};
 use crate::radix::{entry, entry_id, entry_key, insertion_sort_bounded, radix_sort_by_key};
 use crate::sweep::{SortPolicy, SweepCore};
 use crate::volumes::{Proxy, Store, ensure_ratio, overlap, sampled_median};
@@ -781,15 +781,13 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
 
         // Regular volumes (in the cells) and oversized ones, from each volume's largest
         // edge, computed once.
-        self.extents.clear();
-        extend_indexed(&mut self.extents, n, parallel, |i| {
+        fill_indexed(&mut self.extents, n, parallel, |i| {
             proxies[i].extent().to_f64()
         });
         let extents = &self.extents;
         let threshold =
             self.oversize_ratio * sampled_median(n, |i| extents[i], &mut self.selection);
-        self.in_cells.clear();
-        extend_indexed(&mut self.in_cells, n, parallel, |i| extents[i] <= threshold);
+        fill_indexed(&mut self.in_cells, n, parallel, |i| extents[i] <= threshold);
         // One pass over the regular volumes for the cell width, the coordinate scale and
         // the bounding box of the centres (maxima and minima: exact in any order).
         let in_cells = &self.in_cells;
@@ -828,12 +826,13 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             None => 0.0,
         };
 
-        self.entries.clear();
-        self.cells.clear();
-        self.start.clear();
-        match self.geometry {
-            Some(g) => self.sort_into_cells(&g, parallel),
-            None => self.keys.clear(),
+        if let Some(g) = self.geometry {
+            self.sort_into_cells(&g, parallel);
+        } else {
+            self.keys.clear();
+            self.entries.clear();
+            self.cells.clear();
+            self.start.clear();
         }
         self.build_oversized(parallel, scale);
     }
@@ -852,8 +851,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         // re-keying in sorted order below reads 4 bytes per volume at random, not a
         // whole volume.
         let in_cells = &self.in_cells;
-        self.bucket_of.clear();
-        extend_indexed(&mut self.bucket_of, n, parallel, |i| {
+        fill_indexed(&mut self.bucket_of, n, parallel, |i| {
             if in_cells[i] {
                 g.bucket(&cell_of(i as u32)) as u32
             } else {
@@ -874,24 +872,25 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             })
             && insertion_sort_bounded(&mut self.keys, 4 * regular);
         if !coherent {
-            self.keys.clear();
             let ids = &self.regular;
-            extend_indexed(&mut self.keys, regular, parallel, |x| {
+            fill_indexed(&mut self.keys, regular, parallel, |x| {
                 entry(bucket_of[ids[x] as usize], ids[x])
             });
             radix_sort_by_key(&mut self.keys, &mut self.scratch, &mut self.counts);
         }
         fill_starts(&mut self.start, g.buckets, &self.keys, parallel);
         let (keys, store) = (&self.keys, &self.store);
-        extend_indexed(&mut self.entries, regular, parallel, |k| {
+        fill_indexed(&mut self.entries, regular, parallel, |k| {
             let id = entry_id(keys[k]);
             Entry {
                 proxy: proxies[id as usize],
                 id: store.gid(id),
             }
         });
-        if !g.is_dense() {
-            extend_indexed(&mut self.cells, regular, parallel, |k| {
+        if g.is_dense() {
+            self.cells.clear();
+        } else {
+            fill_indexed(&mut self.cells, regular, parallel, |k| {
                 cell_of(entry_id(keys[k]))
             });
         }

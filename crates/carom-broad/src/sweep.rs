@@ -34,7 +34,7 @@ use carom_geometry::Aabb;
 use carom_math::{Real, Vector};
 
 use crate::pairs::{Emitter, PairBuffers};
-use crate::par::{extend_indexed, map_in_place, max_indexed};
+use crate::par::{fill_indexed, map_in_place, max_indexed};
 use crate::radix::{
     entry, entry_id, entry_key, insertion_sort_bounded, key_down, key_up, radix_sort_by_key,
 };
@@ -168,8 +168,7 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
             if coherent {
                 self.last_sort = SortKind::Insertion;
             } else {
-                self.entries.clear();
-                extend_indexed(&mut self.entries, n, parallel, |k| {
+                fill_indexed(&mut self.entries, n, parallel, |k| {
                     entry(key_of(id_at(k)), id_at(k))
                 });
                 radix_sort_by_key(&mut self.entries, &mut self.scratch, &mut self.counts);
@@ -183,30 +182,27 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
 
         // Gather in sweep order: the exact volumes, their keys, their indices.
         let entries = &self.entries;
-        self.proxies.clear();
-        extend_indexed(&mut self.proxies, n, parallel, |k| {
+        fill_indexed(&mut self.proxies, n, parallel, |k| {
             proxies[entry_id(entries[k]) as usize]
         });
         let sorted = &self.proxies;
         for (slot, (lower, upper)) in self.lower.iter_mut().zip(&mut self.upper).enumerate() {
             let a = axis_of_slot(slot, axis);
-            lower.clear();
-            upper.clear();
             if slot == 0 {
+                lower.clear();
                 lower.extend(entries.iter().map(|&e| signed(entry_key(e))));
             } else {
-                extend_indexed(lower, n, parallel, |k| {
+                fill_indexed(lower, n, parallel, |k| {
                     signed(key_down(sorted[k].aabb.min()[a].to_f64()))
                 });
             }
-            extend_indexed(upper, n, parallel, |k| {
+            fill_indexed(upper, n, parallel, |k| {
                 signed(key_up(sorted[k].aabb.max()[a].to_f64()))
             });
             lower.extend([i32::MAX; LANES]);
             upper.extend([i32::MIN; LANES]);
         }
-        self.ids.clear();
-        extend_indexed(&mut self.ids, n, parallel, |k| entry_id(entries[k]));
+        fill_indexed(&mut self.ids, n, parallel, |k| entry_id(entries[k]));
         self.max_extent = max_indexed(n, parallel, |k| {
             let aabb = &sorted[k].aabb;
             aabb.max()[axis].to_f64() - aabb.min()[axis].to_f64()
