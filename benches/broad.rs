@@ -20,7 +20,13 @@
 //!   docs/broad-phase.md (median of repeated frames: ns per ball, pairs per second,
 //!   2-thread speedup) and the 10,000-random-boxes figure. Single-thread figures are
 //!   time on CPU (Linux), so that other processes on a shared machine inflate them
-//!   less; 2-thread figures are wall-clock time.
+//!   less; 2-thread figures are the time on CPU of the busier pool thread (what the
+//!   frame takes on two otherwise idle cores: sequential parts and stolen work
+//!   included), with the wall-clock time beside them.
+//! * `CAROM_BENCH_ORDER=sorted`: balls numbered in a spatial order instead of the
+//!   generators' random one (see [`sort_spatially`]).
+//! * `CAROM_BENCH_PROFILE=phase/case/frames`: a fixed number of frames of one case, for
+//!   `valgrind --tool=callgrind` or `perf record` (see [`profile`]).
 //!
 //! parry's BVH (f32, glam) is built with `Bvh::from_leaves(Binned)` one-shot and
 //! updated with `insert_or_update_partially` + `refit` when coherent, then traversed
@@ -72,7 +78,10 @@ struct Frames<const D: usize> {
 
 impl<const D: usize> Frames<D> {
     fn new(dist: Distribution, n: usize, coherent: bool) -> Self {
-        let a = dist.scene::<D>(n, 1);
+        let mut a = dist.scene::<D>(n, 1);
+        if sorted_order() {
+            sort_spatially(&mut a);
+        }
         let b = if coherent {
             let mut b = a.clone();
             b.step(0.01);
@@ -82,6 +91,26 @@ impl<const D: usize> Frames<D> {
         };
         Self { frames: [a, b] }
     }
+}
+
+/// `CAROM_BENCH_ORDER=sorted`: the balls are numbered in a spatial order (rows of cells
+/// a diameter wide, as an engine that sorts its bodies now and then would have them)
+/// instead of the generators' random order, so that memory is read in the order space
+/// is visited.
+fn sorted_order() -> bool {
+    std::env::var("CAROM_BENCH_ORDER").is_ok_and(|o| o == "sorted")
+}
+
+/// Renumbers the balls of `scene` by their cell (a diameter wide), last axis slowest.
+fn sort_spatially<const D: usize>(scene: &mut Scene<f64, D>) {
+    let width = 2.0 * scene.radii.iter().copied().fold(0.0, f64::max).max(1e-300);
+    let cell = |c: &carom::broad::Vector<f64, D>| -> [i64; D] {
+        core::array::from_fn(|k| (c[D - 1 - k] / width).floor() as i64)
+    };
+    let mut order: Vec<usize> = (0..scene.centers.len()).collect();
+    order.sort_by_key(|&i| cell(&scene.centers[i]));
+    scene.centers = order.iter().map(|&i| scene.centers[i]).collect();
+    scene.radii = order.iter().map(|&i| scene.radii[i]).collect();
 }
 
 /// The broad phases measured, by name.
@@ -308,6 +337,10 @@ fn bench_random_boxes(c: &mut Criterion) {
 }
 
 fn criterion_benches(c: &mut Criterion) {
+    if let Ok(spec) = std::env::var("CAROM_BENCH_PROFILE") {
+        profile(&spec);
+        return;
+    }
     if std::env::var_os("CAROM_BENCH_TABLE").is_some() {
         print_table();
         return;
@@ -365,20 +398,68 @@ fn median_time(cpu: bool, mut f: impl FnMut(usize)) -> Duration {
     times[times.len() / 2]
 }
 
-/// Prints one table row: `case` is "dim | scene | N | frames", `one` and `two` the
-/// frame times on 1 and 2 threads.
-fn row(case: &str, n: usize, name: &str, one: Duration, two: Option<Duration>, pairs: usize) {
+/// The time on CPU of the busiest thread of `pool`, and the wall-clock time, of one
+/// call of `f` (medians as in [`median_time`]). The busiest thread's time is what a
+/// frame would take on otherwise idle cores: it includes the sequential parts (which one
+/// thread runs), and work stolen from a thread the system descheduled, but not the time
+/// a thread waited for the other to be scheduled, which on a shared machine dominates
+/// the wall clock.
+fn median_pool_time(pool: &rayon::ThreadPool, mut f: impl FnMut(usize)) -> (Duration, Duration) {
+    let cpu = || pool.broadcast(|_| on_cpu().unwrap_or_default());
+    let t = Instant::now();
+    f(0);
+    f(1);
+    let per_call = t.elapsed() / 2;
+    let batch = (Duration::from_millis(120).as_nanos() / per_call.as_nanos().max(1))
+        .clamp(1, 100_000) as usize;
+    let (mut busiest, mut walls) = (Vec::new(), Vec::new());
+    let start = Instant::now();
+    let mut k = 0;
+    while busiest.len() < 5 || (start.elapsed() < Duration::from_millis(500) && busiest.len() < 100)
+    {
+        let (t, before) = (Instant::now(), cpu());
+        for _ in 0..batch {
+            f(k);
+            k += 1;
+        }
+        let after = cpu();
+        walls.push(t.elapsed() / batch as u32);
+        let most = after
+            .iter()
+            .zip(&before)
+            .map(|(a, b)| a.saturating_sub(*b))
+            .max()
+            .unwrap_or_default();
+        busiest.push(most / batch as u32);
+    }
+    busiest.sort();
+    walls.sort();
+    (busiest[busiest.len() / 2], walls[walls.len() / 2])
+}
+
+/// Prints one table row: `case` is "dim | scene | N | frames", `one` the frame time on
+/// 1 thread (on CPU), `two` the busiest thread's time on CPU and the wall-clock time on
+/// 2 threads.
+fn row(
+    case: &str,
+    n: usize,
+    name: &str,
+    one: Duration,
+    two: Option<(Duration, Duration)>,
+    pairs: usize,
+) {
     let ns = one.as_secs_f64() * 1e9 / n as f64;
     let mpairs = pairs as f64 / one.as_secs_f64() / 1e6;
-    let (ns2, speedup) = match two {
-        Some(t) => (
+    let (ns2, speedup, wall) = match two {
+        Some((t, w)) => (
             format!("{:.1}", t.as_secs_f64() * 1e9 / n as f64),
             format!("{:.2}", one.as_secs_f64() / t.as_secs_f64()),
+            format!("{:.1}", w.as_secs_f64() * 1e9 / n as f64),
         ),
-        None => ("–".to_owned(), "–".to_owned()),
+        None => ("–".to_owned(), "–".to_owned(), "–".to_owned()),
     };
     println!(
-        "| {case} | {name} | {ns:.1} | {ns2} | {speedup} | {mpairs:.1} | {:.2} |",
+        "| {case} | {name} | {ns:.1} | {ns2} | {speedup} | {wall} | {mpairs:.1} | {:.2} |",
         pairs as f64 / n as f64
     );
 }
@@ -403,7 +484,7 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
                         frame(phase.as_mut(), frames.frames[k % 2].balls(), None, &mut out);
                     });
                     let two_t = (name != "brute").then(|| {
-                        median_time(false, |k| {
+                        median_pool_time(&two, |k| {
                             frame(
                                 phase.as_mut(),
                                 frames.frames[k % 2].balls(),
@@ -437,9 +518,9 @@ fn table_dim<const D: usize>(peer: &mut dyn FnMut() -> Box<dyn Peer<D>>) {
 
 fn print_table() {
     println!(
-        "| dim | scene | N | frames | broad phase | ns/ball 1t | ns/ball 2t | speedup | Mpairs/s 1t | pairs/ball |"
+        "| dim | scene | N | frames | broad phase | ns/ball 1t | ns/ball 2t | speedup | 2t wall ns/ball | Mpairs/s 1t | pairs/ball |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let a = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 1);
     let b = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 2);
     let mut out = Vec::new();
@@ -465,6 +546,66 @@ fn print_table() {
     }
     table_dim::<2>(&mut || Box::new(Parry2::default()));
     table_dim::<3>(&mut || Box::new(Parry3::default()));
+}
+
+// ---------------------------------------------------------------------------------
+// profile mode
+
+/// Runs a fixed number of frames of one case, for instruction counts under
+/// `valgrind --tool=callgrind` (or cachegrind): `CAROM_BENCH_PROFILE=phase/case/frames`,
+/// the case being `boxes` (Terdiman's 10,000 random boxes) or `3D-uniform0.1-1000000-coherent`.
+fn profile(spec: &str) {
+    let parts: Vec<&str> = spec.split('/').collect();
+    let [name, case, frames] = parts[..] else {
+        panic!("CAROM_BENCH_PROFILE=phase/case/frames, e.g. sap/boxes/20");
+    };
+    let frames: usize = frames.parse().expect("frame count");
+    let mut out = Vec::new();
+    if case == "boxes" {
+        let a = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 1);
+        let b = Scene::<f64, 3>::boxes(10_000, 2000.0, 20.0, 2);
+        let mut phase = make_phase::<3>(name, false);
+        for k in 0..frames {
+            let s = if k.is_multiple_of(2) { &a } else { &b };
+            frame(phase.as_mut(), s.aabbs(), None, &mut out);
+        }
+        println!("{} pairs", out.len());
+        return;
+    }
+    let fields: Vec<&str> = case.split('-').collect();
+    let [dim, dist, n, mode] = fields[..] else {
+        panic!("case: dim-scene-n-mode, e.g. 3D-uniform0.1-1000000-coherent");
+    };
+    let dist = match dist {
+        "clustered" => Distribution::Clustered,
+        "mixed" => Distribution::Mixed,
+        d => Distribution::Uniform(d.trim_start_matches("uniform").parse().expect("fraction")),
+    };
+    let n: usize = n.parse().expect("ball count");
+    let coherent = mode == "coherent";
+    let threads = std::env::var("CAROM_BENCH_THREADS").map_or(1, |t| t.parse().unwrap_or(1));
+    let p = pool(threads);
+    let pool = (threads > 1).then_some(&p);
+    macro_rules! run {
+        ($d:literal) => {{
+            let frames_of = Frames::<$d>::new(dist, n, coherent);
+            let mut phase = make_phase::<$d>(name, coherent);
+            for k in 0..frames {
+                frame(
+                    phase.as_mut(),
+                    frames_of.frames[k % 2].balls(),
+                    pool,
+                    &mut out,
+                );
+            }
+        }};
+    }
+    if dim == "2D" {
+        run!(2);
+    } else {
+        run!(3);
+    }
+    println!("{} pairs", out.len());
 }
 
 criterion_group!(benches, criterion_benches);

@@ -13,8 +13,11 @@
 //!   volumes two cells apart, even at `1e6` from the origin.
 //! * **Bucketing.** `(bucket, index)` keys are radix-sorted, or insertion-sorted from the
 //!   previous frame's order when the frame is coherent; `start[bucket]` is then filled
-//!   in one sequential pass and the volumes are gathered in bucket order. No per-cell
-//!   `Vec`, and no random scatter over an array the size of the grid.
+//!   in one pass over the sorted keys (on the rayon pool: disjoint runs of `start`, one
+//!   per chunk of keys) and the volumes are gathered in bucket order. No per-cell
+//!   `Vec`, and no random scatter over an array the size of the grid. Each volume's
+//!   largest edge is computed once; the cell width, the coordinate scale and the
+//!   bounding box of the centres come from one fused pass over the volumes.
 //! * **Oversized volumes** stay out of the cells. From 32 of them on they form a coarser
 //!   level: a grid of the same layout over just them, with its own median and cell size
 //!   (and, recursively, its own coarser level; each level at least halves the count, so
@@ -41,7 +44,7 @@ use carom_geometry::{Aabb, Border};
 use carom_math::{Real, Vector};
 
 use crate::pairs::{Emitter, PairBuffers};
-use crate::par::{extend_indexed, map_in_place, max_indexed};
+use crate::par::{fill_indexed, fold_indexed, try_map_in_place};
 use crate::radix::{entry, entry_id, entry_key, insertion_sort_bounded, radix_sort_by_key};
 use crate::sweep::{SortPolicy, SweepCore};
 use crate::volumes::{Proxy, Store, ensure_ratio, overlap, sampled_median};
@@ -77,6 +80,11 @@ struct Geometry<const D: usize> {
 }
 
 impl<const D: usize> Geometry<D> {
+    /// `true` for the dense layout (open space, buckets are cells).
+    fn is_dense(&self) -> bool {
+        !self.hashed && !self.periodic
+    }
+
     /// The cell of a point.
     #[inline]
     fn cell(&self, p: &[f64; D]) -> Cell<D> {
@@ -162,6 +170,59 @@ fn floor_to_i64(x: f64) -> i64 {
     if (t as f64) > x { t - 1 } else { t }
 }
 
+/// Fills `start` (resized to `buckets + 1`) so that `start[b]` is the first position in
+/// the sorted `keys` whose bucket is `>= b` (`keys.len()` past the last one): one
+/// sequential pass, or, on the rayon pool, one per chunk of keys, each writing the
+/// disjoint run of `start` that its keys determine (so the result is the same).
+#[cfg_attr(not(feature = "parallel"), allow(unused_variables))]
+fn fill_starts(start: &mut Vec<u32>, buckets: usize, keys: &[u64], parallel: bool) {
+    start.resize(buckets + 1, 0);
+    let n = keys.len();
+    // Chunk [p, q) of the keys writes start[x] for x from (the bucket of key p − 1) + 1
+    // up to the bucket of key q − 1, and the last chunk the rest of the array too.
+    let fill = |run: &mut [u32], first: usize, p: usize, q: usize| {
+        let mut b = first;
+        for (k, &e) in keys[p..q].iter().enumerate() {
+            // Keys of a bucket already started (here or in the previous chunk) add nothing.
+            let end = entry_key(e) as usize + 1;
+            if end > b {
+                run[b - first..end - first].fill((p + k) as u32);
+                b = end;
+            }
+        }
+        run[b - first..].fill(q as u32);
+    };
+    let first_of = |p: usize| {
+        if p == 0 {
+            0
+        } else {
+            entry_key(keys[p - 1]) as usize + 1
+        }
+    };
+    #[cfg(feature = "parallel")]
+    if parallel && n >= crate::par::MIN_PARALLEL {
+        use rayon::prelude::*;
+        let chunks = crate::parallel_chunks();
+        let mut runs = Vec::with_capacity(chunks);
+        let mut rest = start.as_mut_slice();
+        for c in 0..chunks {
+            let range = crate::chunk_range(c, chunks, n);
+            let (from, to) = (first_of(range.start), first_of(range.end));
+            let (run, tail) = if c + 1 == chunks {
+                (core::mem::take(&mut rest), &mut [][..])
+            } else {
+                rest.split_at_mut(to - from)
+            };
+            runs.push((run, from, range));
+            rest = tail;
+        }
+        runs.into_par_iter()
+            .for_each(|(run, from, range)| fill(run, from, range.start, range.end));
+        return;
+    }
+    fill(start, 0, 0, n);
+}
+
 /// The forward half of the neighbour offsets: those whose last non-zero component is
 /// positive (4 in 2D, 13 in 3D). With the cell itself they visit each adjacent pair of
 /// cells once.
@@ -195,11 +256,56 @@ fn all_offsets<const D: usize>() -> Vec<Cell<D>> {
         .collect()
 }
 
+/// What the cell geometry needs from the regular volumes: their largest extent, the
+/// largest `|centre|_∞ + extent` (the coordinate scale of roundings) and the bounding box
+/// of their centres.
+#[derive(Clone, Copy, Debug)]
+struct RegularBounds<const D: usize> {
+    width: f64,
+    scale: f64,
+    lo: [f64; D],
+    hi: [f64; D],
+}
+
+impl<const D: usize> RegularBounds<D> {
+    fn empty() -> Self {
+        Self {
+            width: 0.0,
+            scale: 0.0,
+            lo: [f64::INFINITY; D],
+            hi: [f64::NEG_INFINITY; D],
+        }
+    }
+
+    /// These bounds grown to cover a volume with largest edge `extent`.
+    #[inline]
+    fn with<T: Real>(mut self, p: &Proxy<T, D>, extent: f64) -> Self {
+        self.width = self.width.max(extent);
+        let mut amax = 0.0_f64;
+        for k in 0..D {
+            let c = p.center[k].to_f64();
+            amax = amax.max(c.abs());
+            self.lo[k] = self.lo[k].min(c);
+            self.hi[k] = self.hi[k].max(c);
+        }
+        self.scale = self.scale.max(amax + extent);
+        self
+    }
+
+    fn merge(a: Self, b: Self) -> Self {
+        Self {
+            width: a.width.max(b.width),
+            scale: a.scale.max(b.scale),
+            lo: core::array::from_fn(|k| a.lo[k].min(b.lo[k])),
+            hi: core::array::from_fn(|k| a.hi[k].max(b.hi[k])),
+        }
+    }
+}
+
 /// One regular volume in bucket order.
 #[derive(Clone, Copy, Debug)]
 struct Entry<T: Real, const D: usize> {
     proxy: Proxy<T, D>,
-    cell: Cell<D>,
     /// The caller's index (levels hold subsets; see `Store::gid`).
     id: u32,
 }
@@ -216,10 +322,16 @@ pub struct UniformGrid<T: Real, const D: usize> {
     reach: f64,
     start: Vec<u32>,
     entries: Vec<Entry<T, D>>,
+    /// The cell of each entry, for the hashed layout (where a bucket can hold several
+    /// cells) and the periodic one (whose search wraps cell coordinates); empty for the
+    /// dense layout, whose buckets are its cells.
+    cells: Vec<Cell<D>>,
     /// Sorted `(bucket, index)` keys of the regular volumes (kept for the next frame).
     keys: Vec<u64>,
     scratch: Vec<u64>,
     counts: Vec<usize>,
+    /// Per volume: its largest edge length.
+    extents: Vec<f64>,
     /// Per volume: `true` if it is in the cells this frame.
     in_cells: Vec<bool>,
     /// Per volume: its bucket, or `u32::MAX` when it is not in the cells.
@@ -256,9 +368,11 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             reach: 0.0,
             start: Vec::new(),
             entries: Vec::new(),
+            cells: Vec::new(),
             keys: Vec::new(),
             scratch: Vec::new(),
             counts: Vec::new(),
+            extents: Vec::new(),
             in_cells: Vec::new(),
             bucket_of: Vec::new(),
             regular: Vec::new(),
@@ -323,8 +437,9 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
 
     /// Chooses the cell geometry for the regular volumes, or `None` when there is no
     /// usable grid (no regular volume, or a periodic box under 3 cells wide).
-    fn choose_geometry(&self, cell_width: f64, scale: f64) -> Option<Geometry<D>> {
+    fn choose_geometry(&self, bounds: &RegularBounds<D>, scale: f64) -> Option<Geometry<D>> {
         let n = self.regular.len();
+        let cell_width = bounds.width;
         if n == 0 {
             return None;
         }
@@ -359,15 +474,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             }
             layout => {
                 let hashed = matches!(layout, GridLayout::Hashed);
-                let mut lo = [f64::INFINITY; D];
-                let mut hi = [f64::NEG_INFINITY; D];
-                for &i in &self.regular {
-                    let c = self.store.proxies[i as usize].center;
-                    for k in 0..D {
-                        lo[k] = lo[k].min(c[k].to_f64());
-                        hi[k] = hi[k].max(c[k].to_f64());
-                    }
-                }
+                let (lo, hi) = (bounds.lo, bounds.hi);
                 let span = (0..D).fold(0.0_f64, |s, k| s.max(hi[k] - lo[k]));
                 width = width.max(span / MAX_CELLS_PER_AXIS);
                 // Dense grids get an empty padding cell on each side, so that every
@@ -424,7 +531,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                     });
                     let bucket = g.bucket(&cell);
                     for m in self.start[bucket] as usize..self.start[bucket + 1] as usize {
-                        if self.entries[m].cell == cell {
+                        if !g.hashed || self.cells[m] == cell {
                             f(m);
                         }
                     }
@@ -449,7 +556,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
     fn search(&self, c: usize, chunks: usize, emit: &mut Emitter<'_>) {
         let regular = crate::chunk_range(c, chunks, self.entries.len());
         match &self.geometry {
-            Some(g) if !g.hashed && !g.periodic => self.search_dense(g, regular.clone(), emit),
+            Some(g) if g.is_dense() => self.search_dense(g, regular.clone(), emit),
             Some(g) => self.search_general(g, regular.clone(), emit),
             None => {}
         }
@@ -491,9 +598,9 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                     continue;
                 };
                 let bucket = g.bucket(&n);
-                for e in &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
-                {
-                    if e.cell == n {
+                for m in self.start[bucket] as usize..self.start[bucket + 1] as usize {
+                    if !g.hashed || self.cells[m] == n {
+                        let e = &self.entries[m];
                         f(&e.proxy, e.id);
                     }
                 }
@@ -557,21 +664,22 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
     ) {
         let (balls, period) = (self.store.balls, self.store.period.as_ref());
         for k in regular {
-            let a = &self.entries[k];
-            let end = self.start[g.bucket(&a.cell) + 1] as usize;
-            for b in &self.entries[k + 1..end] {
-                if b.cell == a.cell && overlap(&a.proxy, &b.proxy, balls, period) {
+            let (a, a_cell) = (&self.entries[k], &self.cells[k]);
+            let end = self.start[g.bucket(a_cell) + 1] as usize;
+            for m in k + 1..end {
+                let b = &self.entries[m];
+                if self.cells[m] == *a_cell && overlap(&a.proxy, &b.proxy, balls, period) {
                     emit.push(a.id, b.id);
                 }
             }
             for offset in &self.offsets {
-                let Some(cell) = g.neighbour(&a.cell, offset) else {
+                let Some(cell) = g.neighbour(a_cell, offset) else {
                     continue;
                 };
                 let bucket = g.bucket(&cell);
-                for b in &self.entries[self.start[bucket] as usize..self.start[bucket + 1] as usize]
-                {
-                    if b.cell == cell && overlap(&a.proxy, &b.proxy, balls, period) {
+                for m in self.start[bucket] as usize..self.start[bucket + 1] as usize {
+                    let b = &self.entries[m];
+                    if self.cells[m] == cell && overlap(&a.proxy, &b.proxy, balls, period) {
                         emit.push(a.id, b.id);
                     }
                 }
@@ -671,27 +779,31 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         let n = self.store.len();
         let proxies = &self.store.proxies;
 
-        // Regular volumes (in the cells) and oversized ones.
-        let threshold = self.oversize_ratio
-            * sampled_median(n, |i| proxies[i].extent().to_f64(), &mut self.selection);
-        let regular = |i: usize| proxies[i].extent().to_f64() <= threshold;
-        self.in_cells.clear();
-        extend_indexed(&mut self.in_cells, n, parallel, regular);
-        let cell_width = max_indexed(n, parallel, |i| {
-            if regular(i) {
-                proxies[i].extent().to_f64()
-            } else {
-                0.0
-            }
+        // Regular volumes (in the cells) and oversized ones, from each volume's largest
+        // edge, computed once.
+        fill_indexed(&mut self.extents, n, parallel, |i| {
+            proxies[i].extent().to_f64()
         });
-        let scale = max_indexed(n, parallel, |i| {
-            let p = &proxies[i];
-            if regular(i) {
-                p.center.amax().to_f64() + p.extent().to_f64()
-            } else {
-                0.0
-            }
-        });
+        let extents = &self.extents;
+        let threshold =
+            self.oversize_ratio * sampled_median(n, |i| extents[i], &mut self.selection);
+        fill_indexed(&mut self.in_cells, n, parallel, |i| extents[i] <= threshold);
+        // One pass over the regular volumes for the cell width, the coordinate scale and
+        // the bounding box of the centres (maxima and minima: exact in any order).
+        let in_cells = &self.in_cells;
+        let bounds = fold_indexed(
+            n,
+            parallel,
+            RegularBounds::empty,
+            |b, i| {
+                if in_cells[i] {
+                    b.with(&proxies[i], extents[i])
+                } else {
+                    b
+                }
+            },
+            RegularBounds::merge,
+        );
         self.regular.clear();
         self.oversized.clear();
         for (i, &inside) in self.in_cells.iter().enumerate() {
@@ -701,8 +813,8 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
                 self.oversized.push(i as u32);
             }
         }
-        let scale = scale.max(scale_floor);
-        self.geometry = self.choose_geometry(cell_width, scale);
+        let scale = bounds.scale.max(scale_floor);
+        self.geometry = self.choose_geometry(&bounds, scale);
         if self.geometry.is_none() {
             self.oversized.clear();
             self.oversized.extend(0..n as u32);
@@ -714,11 +826,13 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             None => 0.0,
         };
 
-        self.entries.clear();
-        self.start.clear();
-        match self.geometry {
-            Some(g) => self.sort_into_cells(&g, parallel),
-            None => self.keys.clear(),
+        if let Some(g) = self.geometry {
+            self.sort_into_cells(&g, parallel);
+        } else {
+            self.keys.clear();
+            self.entries.clear();
+            self.cells.clear();
+            self.start.clear();
         }
         self.build_oversized(parallel, scale);
     }
@@ -737,8 +851,7 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         // re-keying in sorted order below reads 4 bytes per volume at random, not a
         // whole volume.
         let in_cells = &self.in_cells;
-        self.bucket_of.clear();
-        extend_indexed(&mut self.bucket_of, n, parallel, |i| {
+        fill_indexed(&mut self.bucket_of, n, parallel, |i| {
             if in_cells[i] {
                 g.bucket(&cell_of(i as u32)) as u32
             } else {
@@ -750,44 +863,37 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
         // The previous keys name exactly this frame's regular volumes when there are as
         // many and each is regular (coarser levels renumber their volumes every frame,
         // so an index may also be out of range).
-        let same_set = self.keys.len() == regular
-            && self.keys.iter().all(|&e| {
-                bucket_of
-                    .get(entry_id(e) as usize)
-                    .is_some_and(|&b| b != u32::MAX)
-            });
-        let coherent = same_set && {
-            map_in_place(&mut self.keys, parallel, |e| {
-                entry(bucket_of[entry_id(e) as usize], entry_id(e))
-            });
-            insertion_sort_bounded(&mut self.keys, 4 * regular)
-        };
+        let coherent = self.keys.len() == regular
+            && try_map_in_place(&mut self.keys, parallel, |e| {
+                match bucket_of.get(entry_id(e) as usize) {
+                    Some(&b) if b != u32::MAX => Some(entry(b, entry_id(e))),
+                    _ => None,
+                }
+            })
+            && insertion_sort_bounded(&mut self.keys, 4 * regular);
         if !coherent {
-            self.keys.clear();
             let ids = &self.regular;
-            extend_indexed(&mut self.keys, regular, parallel, |x| {
+            fill_indexed(&mut self.keys, regular, parallel, |x| {
                 entry(bucket_of[ids[x] as usize], ids[x])
             });
             radix_sort_by_key(&mut self.keys, &mut self.scratch, &mut self.counts);
         }
-        // start[b] = the first sorted position whose bucket is >= b (sequential fill).
-        self.start.resize(g.buckets + 1, 0);
-        let mut b = 0;
-        for (k, &e) in self.keys.iter().enumerate() {
-            let bucket = entry_key(e) as usize;
-            self.start[b..=bucket].fill(k as u32);
-            b = bucket + 1;
-        }
-        self.start[b..].fill(regular as u32);
+        fill_starts(&mut self.start, g.buckets, &self.keys, parallel);
         let (keys, store) = (&self.keys, &self.store);
-        extend_indexed(&mut self.entries, regular, parallel, |k| {
+        fill_indexed(&mut self.entries, regular, parallel, |k| {
             let id = entry_id(keys[k]);
             Entry {
                 proxy: proxies[id as usize],
-                cell: cell_of(id),
                 id: store.gid(id),
             }
         });
+        if g.is_dense() {
+            self.cells.clear();
+        } else {
+            fill_indexed(&mut self.cells, regular, parallel, |k| {
+                cell_of(entry_id(keys[k]))
+            });
+        }
     }
 
     /// Puts the oversized volumes in a coarser level when there are enough of them (and
@@ -916,6 +1022,41 @@ mod tests {
         let mut pairs = Vec::new();
         grid.pairs(&mut pairs);
         assert_eq!(pairs, expected);
+    }
+
+    #[test]
+    #[cfg(feature = "parallel")]
+    fn start_fill_is_the_same_sequentially_and_in_parallel() {
+        // Sorted keys with runs that straddle chunk boundaries (dense buckets) and
+        // long gaps (sparse ones), above the size where the fill goes parallel.
+        for (n, buckets) in [(20_000usize, 3_000usize), (20_000, 200_000), (9_000, 1)] {
+            let mut state = n as u64 ^ buckets as u64;
+            let mut keys: Vec<u64> = (0..n as u32)
+                .map(|id| {
+                    state = state
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    entry(((state >> 33) % buckets as u64) as u32, id)
+                })
+                .collect();
+            keys.sort_unstable();
+            // The definition: the first position whose bucket is >= b.
+            let expected: Vec<u32> = (0..=buckets)
+                .map(|b| keys.partition_point(|&e| (entry_key(e) as usize) < b) as u32)
+                .collect();
+            let mut start = vec![7; 5];
+            fill_starts(&mut start, buckets, &keys, false);
+            assert_eq!(start, expected);
+            for threads in [1, 2, 3] {
+                let mut start = Vec::new();
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| fill_starts(&mut start, buckets, &keys, true));
+                assert_eq!(start, expected, "{threads} threads");
+            }
+        }
     }
 
     #[test]

@@ -16,25 +16,28 @@
 #[inline]
 fn ordered_bits(x: f32) -> u32 {
     let bits = x.to_bits();
-    if bits & 0x8000_0000 == 0 {
-        bits | 0x8000_0000
-    } else {
-        !bits
-    }
+    // Positive: flip the sign bit; negative: flip every bit (no branch).
+    bits ^ ((bits.cast_signed() >> 31).cast_unsigned() | 0x8000_0000)
 }
 
 /// The key of a lower bound: the integer image of the largest `f32 <= x`.
+///
+/// `x as f32` rounds to nearest (to `±inf` beyond the `f32` range); when that went up,
+/// the next `f32` down has the next lower image, since consecutive floats have
+/// consecutive images (`-0.0` and `+0.0` included, which only makes the key one step
+/// more conservative). No branch, no `next_down`.
 #[inline]
 pub(crate) fn key_down(x: f64) -> u32 {
     let f = x as f32;
-    ordered_bits(if f64::from(f) > x { f.next_down() } else { f })
+    ordered_bits(f) - u32::from(f64::from(f) > x)
 }
 
-/// The key of an upper bound: the integer image of the smallest `f32 >= x`.
+/// The key of an upper bound: the integer image of the smallest `f32 >= x` (see
+/// [`key_down`]).
 #[inline]
 pub(crate) fn key_up(x: f64) -> u32 {
     let f = x as f32;
-    ordered_bits(if f64::from(f) < x { f.next_up() } else { f })
+    ordered_bits(f) + u32::from(f64::from(f) < x)
 }
 
 /// The sort entry of index `id` with key `key`.
@@ -154,6 +157,53 @@ mod tests {
         assert_eq!(key_down(0.5), key_up(0.5));
         // Beyond the f32 range the upper key is +inf's and still below the sentinel.
         assert!(key_up(1e300) < u32::MAX);
+    }
+
+    #[test]
+    fn keys_are_the_images_of_the_nearest_f32_bounds() {
+        // The reference: round, then step with next_down / next_up when the rounding
+        // went the wrong way.
+        let reference = |x: f64| {
+            let f = x as f32;
+            let down = if f64::from(f) > x { f.next_down() } else { f };
+            let up = if f64::from(f) < x { f.next_up() } else { f };
+            (ordered_bits(down), ordered_bits(up))
+        };
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            1e-320,
+            -1e-320,
+            f64::from(f32::MIN_POSITIVE) * 0.5,
+            f64::from(f32::MAX),
+            f64::from(f32::MAX) * 1.0000001,
+            -f64::from(f32::MAX) * 1.0000001,
+            1e300,
+            -1e300,
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let mut state = 99u64;
+        for _ in 0..20_000 {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let x = f64::from_bits(state);
+            if !x.is_nan() {
+                xs.push(x);
+            }
+            xs.push(((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e3);
+        }
+        for x in xs {
+            let (down, up) = reference(x);
+            // -0.0 and +0.0 are the same number: the branch-free key may pick either.
+            let zero = |k: u32| k == ordered_bits(0.0) || k == ordered_bits(-0.0);
+            let same = |a: u32, b: u32| a == b || (zero(a) && zero(b));
+            assert!(same(key_down(x), down), "key_down({x:e})");
+            assert!(same(key_up(x), up), "key_up({x:e})");
+        }
     }
 
     #[test]

@@ -8,15 +8,21 @@
 //! * **Axis by variance.** The axis on which the box centres vary most separates the
 //!   most; with coherent frames the axis only changes when another one's variance is
 //!   twice as large (a change costs a full sort).
-//! * **Integer keys.** Bounds become order-preserving `u32` keys (see [`crate::radix`]):
-//!   the sweep compares integers, and one-shot frames sort with a three-pass radix sort.
-//! * **Sentinel.** A `u32::MAX` key after the last volume ends every sweep at the last
-//!   volume (the scan is a slice iterator, so Rust adds no bounds checks either).
-//! * **Sorted struct-of-arrays.** The integer keys of every axis (sweep axis first,
-//!   8 bytes per axis), the exact volumes and the indices are copied into separate
-//!   arrays in sweep order: the inner loop streams through the keys alone and rejects
-//!   almost every candidate with integer compares combined into one branch; only
-//!   survivors read the exact volume, also in sweep order.
+//! * **Integer keys.** Bounds become order-preserving `u32` keys (see [`crate::radix`],
+//!   computed without branches): the sweep compares integers, and one-shot frames sort
+//!   with a three-pass radix sort.
+//! * **Sorted struct-of-arrays.** The keys of each axis (sweep axis first), the exact
+//!   volumes and the indices are copied into separate arrays in sweep order, so the
+//!   inner loop streams through the keys alone; only survivors read the exact volume,
+//!   also in sweep order.
+//! * **Branch-light blocks.** The inner loop tests blocks of 8 candidates at once with
+//!   compares and ands that the compiler turns into SIMD instructions (keys are stored
+//!   as `i32` with the order kept, since SSE2 compares signed integers), then makes one
+//!   branch per block: almost every block has no candidate overlapping on all axes.
+//!   This removes the mispredicted branches of a per-candidate loop, which cost more
+//!   than the compares (2.5× faster on Terdiman's 10,000 boxes).
+//! * **Sentinels.** Every key array ends with 8 keys that overlap nothing, so a block
+//!   may run past the last volume and the scan needs one length check per block.
 //! * **Incremental insertion sort** for coherent frames: the previous order is re-keyed
 //!   and insertion-sorted, `O(N + swaps)`. It gives up after `4N` moves and radix-sorts
 //!   instead, so an incoherent frame costs little more than a one-shot sort.
@@ -28,7 +34,7 @@ use carom_geometry::Aabb;
 use carom_math::{Real, Vector};
 
 use crate::pairs::{Emitter, PairBuffers};
-use crate::par::{extend_indexed, map_in_place, max_indexed};
+use crate::par::{fill_indexed, map_in_place, max_indexed};
 use crate::radix::{
     entry, entry_id, entry_key, insertion_sort_bounded, key_down, key_up, radix_sort_by_key,
 };
@@ -59,47 +65,32 @@ pub enum SortKind {
     Radix,
 }
 
-/// The integer keys of a box (bounds rounded outward to `f32`), the sweep axis first:
-/// `min[0]`/`max[0]` are on the sweep axis, `min[1..]`/`max[1..]` on the others. The
-/// sweep reads only these 8 bytes per axis until a candidate passes every axis.
-#[derive(Clone, Copy, Debug)]
-struct KeyBox<const D: usize> {
-    min: [u32; D],
-    max: [u32; D],
+/// Candidates tested together by the sweep's inner loop: their key tests have no
+/// branch between them (the compiler turns them into SIMD compares and a bit mask), and
+/// the key arrays carry this many sentinels so that a block may run past the last volume.
+const LANES: usize = 8;
+
+/// A `u32` sort key as an `i32` with the same order (the top bit flipped), so that the
+/// sweep's comparisons are the signed integer compares every SIMD instruction set has.
+#[inline]
+fn signed(key: u32) -> i32 {
+    (key ^ 0x8000_0000).cast_signed()
 }
 
-impl<const D: usize> KeyBox<D> {
-    /// The key box of `proxy` with `axis` moved to the front.
-    fn of<T: Real>(proxy: &Proxy<T, D>, axis: usize) -> Self {
-        let (lo, hi) = (proxy.aabb.min(), proxy.aabb.max());
-        // Slot 0 holds the sweep axis; slot d > 0 holds axis d − 1 or d (skipping it).
-        let axis_of = |slot: usize| match slot {
-            0 => axis,
-            s if s <= axis => s - 1,
-            s => s,
-        };
-        Self {
-            min: core::array::from_fn(|s| key_down(lo[axis_of(s)].to_f64())),
-            max: core::array::from_fn(|s| key_up(hi[axis_of(s)].to_f64())),
-        }
-    }
-
-    /// `true` if the boxes' keys overlap on every axis but the sweep axis. Non-short-
-    /// circuit `&`: one well-predicted branch instead of one per comparison.
-    #[inline]
-    #[allow(clippy::needless_bitwise_bool)] // deliberate, see above
-    fn overlap_off_axis(&self, other: &Self) -> bool {
-        let mut all = true;
-        for s in 1..D {
-            all &= (other.min[s] <= self.max[s]) & (self.min[s] <= other.max[s]);
-        }
-        all
+/// The slot of `axis` when the sweep axis `sweep` is moved to the front: slot 0 holds
+/// the sweep axis, slot `s > 0` axis `s − 1` or `s` (skipping the sweep axis).
+#[inline]
+fn axis_of_slot(slot: usize, sweep: usize) -> usize {
+    match slot {
+        0 => sweep,
+        s if s <= sweep => s - 1,
+        s => s,
     }
 }
 
 /// The sorted state of a sweep over some volumes of a [`Store`] (all of them, or a
 /// subset such as the oversized volumes of a grid or k-d tree).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub(crate) struct SweepCore<T: Real, const D: usize> {
     axis: usize,
     /// The largest box extent on the sweep axis (for queries).
@@ -107,12 +98,33 @@ pub(crate) struct SweepCore<T: Real, const D: usize> {
     entries: Vec<u64>,
     scratch: Vec<u64>,
     counts: Vec<usize>,
-    /// In sweep order: the keys on every axis (and one sentinel), the exact volume and
-    /// its index.
-    keys: Vec<KeyBox<D>>,
+    /// In sweep order, per slot (slot 0 the sweep axis, see [`axis_of_slot`]): the
+    /// signed keys of the lower and upper bounds, each followed by [`LANES`] sentinels
+    /// (`i32::MAX` lower, `i32::MIN` upper bounds: they overlap nothing). The upper key
+    /// of every real volume, even `+inf`'s, is below `i32::MAX`.
+    lower: [Vec<i32>; D],
+    upper: [Vec<i32>; D],
+    /// In sweep order: the exact volumes and their indices.
     proxies: Vec<Proxy<T, D>>,
     ids: Vec<u32>,
     last_sort: SortKind,
+}
+
+impl<T: Real, const D: usize> Default for SweepCore<T, D> {
+    fn default() -> Self {
+        Self {
+            axis: 0,
+            max_extent: 0.0,
+            entries: Vec::new(),
+            scratch: Vec::new(),
+            counts: Vec::new(),
+            lower: core::array::from_fn(|_| Vec::new()),
+            upper: core::array::from_fn(|_| Vec::new()),
+            proxies: Vec::new(),
+            ids: Vec::new(),
+            last_sort: SortKind::None,
+        }
+    }
 }
 
 impl<T: Real, const D: usize> SweepCore<T, D> {
@@ -156,8 +168,7 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
             if coherent {
                 self.last_sort = SortKind::Insertion;
             } else {
-                self.entries.clear();
-                extend_indexed(&mut self.entries, n, parallel, |k| {
+                fill_indexed(&mut self.entries, n, parallel, |k| {
                     entry(key_of(id_at(k)), id_at(k))
                 });
                 radix_sort_by_key(&mut self.entries, &mut self.scratch, &mut self.counts);
@@ -171,26 +182,30 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
 
         // Gather in sweep order: the exact volumes, their keys, their indices.
         let entries = &self.entries;
-        self.proxies.clear();
-        extend_indexed(&mut self.proxies, n, parallel, |k| {
+        fill_indexed(&mut self.proxies, n, parallel, |k| {
             proxies[entry_id(entries[k]) as usize]
         });
         let sorted = &self.proxies;
-        self.keys.clear();
-        extend_indexed(&mut self.keys, n, parallel, |k| {
-            KeyBox::of(&sorted[k], axis)
-        });
-        self.ids.clear();
-        extend_indexed(&mut self.ids, n, parallel, |k| entry_id(entries[k]));
-        debug_assert!((0..n).all(|k| self.keys[k].min[0] == entry_key(entries[k])));
+        for (slot, (lower, upper)) in self.lower.iter_mut().zip(&mut self.upper).enumerate() {
+            let a = axis_of_slot(slot, axis);
+            if slot == 0 {
+                lower.clear();
+                lower.extend(entries.iter().map(|&e| signed(entry_key(e))));
+            } else {
+                fill_indexed(lower, n, parallel, |k| {
+                    signed(key_down(sorted[k].aabb.min()[a].to_f64()))
+                });
+            }
+            fill_indexed(upper, n, parallel, |k| {
+                signed(key_up(sorted[k].aabb.max()[a].to_f64()))
+            });
+            lower.extend([i32::MAX; LANES]);
+            upper.extend([i32::MIN; LANES]);
+        }
+        fill_indexed(&mut self.ids, n, parallel, |k| entry_id(entries[k]));
         self.max_extent = max_indexed(n, parallel, |k| {
             let aabb = &sorted[k].aabb;
             aabb.max()[axis].to_f64() - aabb.min()[axis].to_f64()
-        });
-        // The sentinel: its lower key u32::MAX exceeds every upper key.
-        self.keys.push(KeyBox {
-            min: [u32::MAX; D],
-            max: [u32::MAX; D],
         });
     }
 
@@ -217,18 +232,45 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
             }
         };
         for k in range {
-            let a = self.keys[k];
+            let a_lower: [i32; D] = core::array::from_fn(|s| self.lower[s][k]);
+            let a_upper: [i32; D] = core::array::from_fn(|s| self.upper[s][k]);
+            // The keys after `a`, all of the same length (the sentinels included), so
+            // that one length check per block covers every array.
+            let len = self.lower[0].len() - (k + 1);
+            let lower: [&[i32]; D] = core::array::from_fn(|s| &self.lower[s][k + 1..][..len]);
+            let upper: [&[i32]; D] = core::array::from_fn(|s| &self.upper[s][k + 1..][..len]);
             // Every later volume starts at or after `a` on the sweep axis, so it overlaps
-            // there exactly while its lower key is at most a's upper key. The sentinel
-            // ends the scan at the last volume; the iterator removes bounds checks.
-            for (b, j) in self.keys[k + 1..].iter().zip(k + 1..) {
-                if b.min[0] > a.max[0] {
+            // there exactly while its lower key is at most a's upper key. Blocks of
+            // LANES candidates are tested without branches (1 in `hit` for a candidate
+            // whose keys overlap a's on every axis, 0 otherwise: SIMD compares and ands);
+            // the block whose last lower key passes a's upper key (a sentinel at the
+            // latest) ends the scan.
+            let mut j = 0;
+            while j + LANES <= len {
+                let lower0 = &lower[0][j..j + LANES];
+                let mut hit = [0u8; LANES];
+                for (h, &l) in hit.iter_mut().zip(lower0) {
+                    *h = u8::from(l <= a_upper[0]);
+                }
+                for s in 1..D {
+                    let (lo, hi) = (&lower[s][j..j + LANES], &upper[s][j..j + LANES]);
+                    for t in 0..LANES {
+                        hit[t] &= u8::from(lo[t] <= a_upper[s]) & u8::from(a_lower[s] <= hi[t]);
+                    }
+                }
+                // Key overlaps on every axis are rare: one test for the whole block.
+                if u64::from_le_bytes(hit) != 0 {
+                    for (t, _) in hit.iter().enumerate().filter(|(_, h)| **h != 0) {
+                        let b = k + 1 + j + t;
+                        if overlap(&self.proxies[k], &self.proxies[b], balls, None) {
+                            emit.push(gid(self.ids[k]), gid(self.ids[b]));
+                        }
+                    }
+                }
+                if lower0[LANES - 1] > a_upper[0] {
                     break;
                 }
-                if a.overlap_off_axis(b) && overlap(&self.proxies[k], &self.proxies[j], balls, None)
-                {
-                    emit.push(gid(self.ids[k]), gid(self.ids[j]));
-                }
+                j += LANES;
             }
         }
     }
@@ -241,8 +283,9 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
         // then step one f32 below the key of the difference to cover its rounding.
         let from = key_down(lo - self.max_extent * (1.0 + 4.0 * f64::EPSILON)).saturating_sub(1);
         let to = key_up(hi);
-        let first = self.keys[..n].partition_point(|k| k.min[0] < from);
-        let last = self.keys[..n].partition_point(|k| k.min[0] <= to);
+        let keys = &self.lower[0][..n];
+        let first = keys.partition_point(|&k| k < signed(from));
+        let last = keys.partition_point(|&k| k <= signed(to));
         for &id in &self.ids[first..last.max(first)] {
             f(id);
         }

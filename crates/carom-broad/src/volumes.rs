@@ -26,7 +26,7 @@
 use carom_geometry::{Aabb, Border, BoundingVolume};
 use carom_math::{InvalidValue, Problem, Real, Vector, ensure_finite_vector, ensure_non_negative};
 
-use crate::par::extend_indexed;
+use crate::par::fill_indexed;
 
 /// Bounding volumes for one update: boxes or balls.
 #[derive(Clone, Copy, Debug)]
@@ -212,8 +212,10 @@ impl<T: Real, const D: usize> Proxy<T, D> {
     }
 
     /// The largest edge length of the box.
+    #[inline]
     pub(crate) fn extent(&self) -> T {
-        self.aabb.extents().max()
+        let (lo, hi) = (self.aabb.min(), self.aabb.max());
+        (0..D).fold(T::zero(), |m, k| m.max(hi[k] - lo[k]))
     }
 }
 
@@ -309,17 +311,16 @@ impl<T: Real, const D: usize> Store<T, D> {
     /// Copies the volumes in (reusing the buffer).
     pub(crate) fn load(&mut self, volumes: Volumes<'_, T, D>, parallel: bool) {
         self.global.clear();
-        self.proxies.clear();
         match volumes {
             Volumes::Boxes(boxes) => {
                 self.balls = false;
-                extend_indexed(&mut self.proxies, boxes.len(), parallel, |i| {
+                fill_indexed(&mut self.proxies, boxes.len(), parallel, |i| {
                     Proxy::from_box(&boxes[i])
                 });
             }
             Volumes::Balls(b) => {
                 self.balls = true;
-                extend_indexed(&mut self.proxies, b.len(), parallel, |i| {
+                fill_indexed(&mut self.proxies, b.len(), parallel, |i| {
                     Proxy::from_ball(&b.centers[i], b.radii[i] + b.margin)
                 });
             }
@@ -330,12 +331,10 @@ impl<T: Real, const D: usize> Store<T, D> {
     pub(crate) fn load_subset(&mut self, parent: &Self, ids: &[u32], parallel: bool) {
         self.balls = parent.balls;
         self.period = parent.period;
-        self.proxies.clear();
-        extend_indexed(&mut self.proxies, ids.len(), parallel, |x| {
+        fill_indexed(&mut self.proxies, ids.len(), parallel, |x| {
             parent.proxies[ids[x] as usize]
         });
-        self.global.clear();
-        extend_indexed(&mut self.global, ids.len(), parallel, |x| {
+        fill_indexed(&mut self.global, ids.len(), parallel, |x| {
             parent.gid(ids[x])
         });
     }
