@@ -167,6 +167,10 @@ fn balls(
     Ok(())
 }
 
+/// Half the length of the side view: the room (±4 m) seen along the tilted table reaches
+/// at most its diagonal.
+const SIDE_REACH: f64 = 5.7;
+
 /// The top and side views at frame `upto`.
 fn views(canvas: &Canvas<'_>, frame: &Frame, rally: &Rally, upto: usize, width: f64) -> Drawn {
     let along = |p: &Vector3<f64>| (frame.local(p).x, p.z);
@@ -178,9 +182,10 @@ fn views(canvas: &Canvas<'_>, frame: &Frame, rally: &Rally, upto: usize, width: 
         (gap, 90.0),
         (gap + half, 90.0 + half * 0.92),
     );
+    // Along the table, the room's corners are up to 4√2 m from the centre.
     let side_view = View::fit(
-        (-4.0, 0.0),
-        (4.0, 2.0),
+        (-SIDE_REACH, 0.0),
+        (SIDE_REACH, 2.0),
         (2.0 * gap + half, 90.0),
         (width - gap, 90.0 + half * 0.92),
     );
@@ -197,7 +202,7 @@ fn views(canvas: &Canvas<'_>, frame: &Frame, rally: &Rally, upto: usize, width: 
         ),
     ] {
         let (lo, hi) = if side {
-            ((-4.0, 0.0), (4.0, 2.0))
+            ((-SIDE_REACH, 0.0), (SIDE_REACH, 2.0))
         } else {
             ((-4.0, -4.0), (4.0, 4.0))
         };
