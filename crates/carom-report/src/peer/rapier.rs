@@ -15,6 +15,8 @@
 //!   a ball–wall contact gets exactly `e_w`; other mixtures are refused;
 //! * the reflecting border is four fixed cuboid walls outside it, boxes are fixed (or
 //!   velocity-based kinematic, when they move) cuboids at their rotation;
+//! * rapier's speed cap (`normalized_max_linear_velocity`, 400 m/s by default, which
+//!   silently slows every faster body) is lifted: a carom scene has no speed limit;
 //! * everything else is rapier's default `IntegrationParameters` (recorded by
 //!   [`RapierScene::settings`]) with `dt` set to the step.
 //!
@@ -36,6 +38,17 @@ impl fmt::Display for Unsupported {
 }
 
 impl std::error::Error for Unsupported {}
+
+/// An empty world with `gravity`, stepping `dt`, without rapier's speed cap.
+fn empty_world(gravity: [f64; 2], dt: f64) -> PhysicsWorld {
+    let mut world = PhysicsWorld {
+        gravity: Vector::new(gravity[0] as f32, gravity[1] as f32),
+        ..PhysicsWorld::default()
+    };
+    world.integration_parameters.dt = dt as f32;
+    world.integration_parameters.normalized_max_linear_velocity = f32::MAX;
+    world
+}
 
 /// A rapier2d world holding a carom 2D scene.
 pub struct RapierScene {
@@ -88,11 +101,7 @@ impl RapierScene {
         };
 
         let g = s.world.gravity;
-        let mut world = PhysicsWorld {
-            gravity: Vector::new(g.x as f32, g.y as f32),
-            ..PhysicsWorld::default()
-        };
-        world.integration_parameters.dt = dt as f32;
+        let mut world = empty_world([g.x, g.y], dt);
 
         if let Some(border) = s.world.border {
             let rule = wall(border.restitution)?;
@@ -159,6 +168,38 @@ impl RapierScene {
         Ok(Self { world, balls })
     }
 
+    /// One ball of `mass` and `radius` tied to a fixed point at the origin by rapier's
+    /// spring joint (force-based: `stiffness` in N/m and `damping` in N·s/m, as carom's
+    /// `Spring`, of `rest_length`), starting at rest at `pos`, without gravity: the damped
+    /// spring of the work-precision section. rapier integrates joint springs implicitly
+    /// (its documentation: "implicit integration which adds some numerical damping").
+    pub fn anchored_spring(
+        mass: f64,
+        radius: f64,
+        (stiffness, damping, rest_length): (f64, f64, f64),
+        pos: [f64; 2],
+        dt: f64,
+    ) -> Self {
+        let mut world = empty_world([0.0, 0.0], dt);
+        let anchor = world.insert_body(RigidBodyBuilder::fixed());
+        let (ball, _) = world.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(pos[0] as f32, pos[1] as f32))
+                .can_sleep(false),
+            ColliderBuilder::ball(radius as f32).mass(mass as f32),
+        );
+        world.insert_impulse_joint(
+            anchor,
+            ball,
+            SpringJointBuilder::new(rest_length as f32, stiffness as f32, damping as f32)
+                .spring_model(MotorModel::ForceBased),
+        );
+        Self {
+            world,
+            balls: vec![ball],
+        }
+    }
+
     /// One step of `dt`.
     pub fn step(&mut self) {
         self.world.step();
@@ -203,7 +244,7 @@ impl RapierScene {
     pub fn settings(&self) -> String {
         let p = &self.world.integration_parameters;
         format!(
-            "rapier2d 0.36 (f32): dt {}, {} solver iterations, {} CCD substeps, CCD on, friction 0",
+            "rapier2d 0.36 (f32): dt {}, {} solver iterations, {} CCD substeps, CCD on, friction 0, no speed cap",
             p.dt, p.num_solver_iterations, p.max_ccd_substeps
         )
     }
