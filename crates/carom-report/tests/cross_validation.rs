@@ -264,6 +264,13 @@ fn newtons_cradle_passes_the_whole_momentum_to_the_last_ball() {
         expected[0].pos.x = -0.2;
         expected[n].pos.x += 1.5;
         expected[n].vel.x = 1.0;
+        let (_, rv) = rapier(&s, t);
+        println!(
+            "Newton's cradle, {n}: rapier2d's final x velocities {:?}",
+            rv.iter()
+                .map(|v| (v.x * 1e3).round() / 1e3)
+                .collect::<Vec<_>>()
+        );
         check(
             &format!("Newton's cradle, {n} balls at rest"),
             three_way(&s, t, &expected),
