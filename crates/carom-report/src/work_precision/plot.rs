@@ -138,6 +138,24 @@ const COLOURS: [RGBColor; 10] = [
 /// Width of the legend panel right of the chart (pixels).
 const LEGEND_WIDTH: u32 = 280;
 
+/// What a reader needs to know about the methods a problem's plot does not show.
+fn notes(problem: &str) -> &'static [&'static str] {
+    match problem {
+        "projectile-drag" => &["carom-event: not run, drag has", "no exact time of impact"],
+        "stiff-spring" => &[
+            "carom-integrate directly: the",
+            "engines have no springs; exact:",
+            "refused (no closed form);",
+            "rapier2d: its spring joint",
+        ],
+        "two-ball" | "elastic-gas" => &[
+            "no forces: every integrator",
+            "flies the same straight lines",
+        ],
+        _ => &[],
+    }
+}
+
 fn draw<DB: DrawingBackend>(
     problem: &str,
     rows: &[&WorkPrecisionRow],
@@ -204,6 +222,10 @@ fn draw<DB: DrawingBackend>(
         ))?;
         legend_area.draw(&Circle::new((21, y), radius, colour.stroke_width(2)))?;
         legend_area.draw(&Text::new(*method, (42, y - 7), font.clone()))?;
+    }
+    let below = 90 + 24 * methods.len() as i32 + 10;
+    for (k, line) in notes(problem).iter().enumerate() {
+        legend_area.draw(&Text::new(*line, (8, below + 18 * k as i32), font.clone()))?;
     }
     area.present()
 }
