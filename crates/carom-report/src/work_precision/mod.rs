@@ -63,11 +63,11 @@ impl Sizes {
                 repeats: 3,
             },
             Mode::Full => Self {
-                steps: halvings(1.0 / 30.0, 11),
+                steps: halvings(1.0 / 30.0, 9),
                 spring_steps: halvings(1e-2, 12),
-                gas_balls: 2000,
-                gas_seconds: 10.0,
-                repeats: 7,
+                gas_balls: 1000,
+                gas_seconds: 5.0,
+                repeats: 5,
             },
         }
     }
