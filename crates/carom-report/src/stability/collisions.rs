@@ -93,17 +93,26 @@ fn runs(
     t: f64,
     with_rapier: bool,
 ) -> Vec<(String, Result<Outcome, String>)> {
-    let mut out: Vec<_> = CAROM
+    CAROM
         .iter()
         .map(|&m| (engine_name(m), carom(scene, m, t)))
-        .collect();
+        .chain(if with_rapier {
+            reference_runs(scene, t)
+        } else {
+            Vec::new()
+        })
+        .collect()
+}
+
+/// rapier2d's run for reference, when the feature is on (none without it).
+fn reference_runs(scene: &Scene<f64, 2>, t: f64) -> Vec<(String, Result<Outcome, String>)> {
     #[cfg(feature = "rapier")]
-    if with_rapier {
-        out.push(("rapier2d (reference)".to_owned(), rapier(scene, t)));
-    }
+    return vec![("rapier2d (reference)".to_owned(), rapier(scene, t))];
     #[cfg(not(feature = "rapier"))]
-    let _ = with_rapier;
-    out
+    {
+        let _ = (scene, t);
+        Vec::new()
+    }
 }
 
 fn engine_name(m: Method) -> String {
