@@ -15,6 +15,8 @@
 //!   a ball–wall contact gets exactly `e_w`; other mixtures are refused;
 //! * the reflecting border is four fixed cuboid walls outside it, boxes are fixed (or
 //!   velocity-based kinematic, when they move) cuboids at their rotation;
+//! * rapier's speed cap (`normalized_max_linear_velocity`, 400 m/s by default, which
+//!   silently slows every faster body) is lifted: a carom scene has no speed limit;
 //! * everything else is rapier's default `IntegrationParameters` (recorded by
 //!   [`RapierScene::settings`]) with `dt` set to the step.
 //!
@@ -36,6 +38,17 @@ impl fmt::Display for Unsupported {
 }
 
 impl std::error::Error for Unsupported {}
+
+/// An empty world with `gravity`, stepping `dt`, without rapier's speed cap.
+fn empty_world(gravity: [f64; 2], dt: f64) -> PhysicsWorld {
+    let mut world = PhysicsWorld {
+        gravity: Vector::new(gravity[0] as f32, gravity[1] as f32),
+        ..PhysicsWorld::default()
+    };
+    world.integration_parameters.dt = dt as f32;
+    world.integration_parameters.normalized_max_linear_velocity = f32::MAX;
+    world
+}
 
 /// A rapier2d world holding a carom 2D scene.
 pub struct RapierScene {
@@ -66,15 +79,32 @@ impl RapierScene {
             .iter()
             .map(|b| b.restitution.unwrap_or(s.world.restitution))
             .collect();
-        let surfaces = Surfaces::new(&ball_e);
-        let g = s.world.gravity;
-        let mut world = PhysicsWorld {
-            gravity: Vector::new(g.x as f32, g.y as f32),
-            ..PhysicsWorld::default()
+        let (e_lo, e_hi) = ball_e
+            .iter()
+            .fold((1.0_f64, 0.0_f64), |(lo, hi), &e| (lo.min(e), hi.max(e)));
+        let wall = |e: f64| -> Result<CoefficientCombineRule, Unsupported> {
+            if e <= e_lo {
+                Ok(CoefficientCombineRule::Min)
+            } else if e >= e_hi {
+                Ok(CoefficientCombineRule::Max)
+            } else {
+                Err(Unsupported(
+                    "a wall or box restitution between the balls' smallest and largest",
+                ))
+            }
         };
-        world.integration_parameters.dt = dt as f32;
+        let surface = |c: ColliderBuilder, e: f64, rule| {
+            c.restitution(e as f32)
+                .restitution_combine_rule(rule)
+                .friction(0.0)
+                .friction_combine_rule(CoefficientCombineRule::Min)
+        };
+
+        let g = s.world.gravity;
+        let mut world = empty_world([g.x, g.y], dt);
+
         if let Some(border) = s.world.border {
-            let rule = surfaces.wall_rule(border.restitution)?;
+            let rule = wall(border.restitution)?;
             let (lo, hi) = (border.border.min(), border.border.max());
             let (cx, cy) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
             let (hx, hy) = (0.5 * (hi.x - lo.x), 0.5 * (hi.y - lo.y));
@@ -97,7 +127,7 @@ impl RapierScene {
             }
         }
         for b in &s.boxes {
-            let rule = surfaces.wall_rule(b.restitution)?;
+            let rule = wall(b.restitution)?;
             let (c, h) = (b.shape.center(), b.shape.half_extents());
             let body = if b.vel == nalgebra::Vector2::zeros() {
                 RigidBodyBuilder::fixed()
@@ -136,6 +166,38 @@ impl RapierScene {
             })
             .collect();
         Ok(Self { world, balls })
+    }
+
+    /// One ball of `mass` and `radius` tied to a fixed point at the origin by rapier's
+    /// spring joint (force-based: `stiffness` in N/m and `damping` in N·s/m, as carom's
+    /// `Spring`, of `rest_length`), starting at rest at `pos`, without gravity: the damped
+    /// spring of the work-precision section. rapier integrates joint springs implicitly
+    /// (its documentation: "implicit integration which adds some numerical damping").
+    pub fn anchored_spring(
+        mass: f64,
+        radius: f64,
+        (stiffness, damping, rest_length): (f64, f64, f64),
+        pos: [f64; 2],
+        dt: f64,
+    ) -> Self {
+        let mut world = empty_world([0.0, 0.0], dt);
+        let anchor = world.insert_body(RigidBodyBuilder::fixed());
+        let (ball, _) = world.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(pos[0] as f32, pos[1] as f32))
+                .can_sleep(false),
+            ColliderBuilder::ball(radius as f32).mass(mass as f32),
+        );
+        world.insert_impulse_joint(
+            anchor,
+            ball,
+            SpringJointBuilder::new(rest_length as f32, stiffness as f32, damping as f32)
+                .spring_model(MotorModel::ForceBased),
+        );
+        Self {
+            world,
+            balls: vec![ball],
+        }
     }
 
     /// One step of `dt`.
@@ -182,46 +244,8 @@ impl RapierScene {
     pub fn settings(&self) -> String {
         let p = &self.world.integration_parameters;
         format!(
-            "rapier2d 0.36 (f32): dt {}, {} solver iterations, {} CCD substeps, CCD on, friction 0",
+            "rapier2d 0.36 (f32): dt {}, {} solver iterations, {} CCD substeps, CCD on, friction 0, no speed cap",
             p.dt, p.num_solver_iterations, p.max_ccd_substeps
         )
     }
-}
-
-/// The balls' range of restitution coefficients, which decides a wall's combine rule.
-struct Surfaces {
-    /// The smallest ball coefficient.
-    lowest: f64,
-    /// The largest ball coefficient.
-    highest: f64,
-}
-
-impl Surfaces {
-    fn new(ball_restitution: &[f64]) -> Self {
-        let (lowest, highest) = ball_restitution
-            .iter()
-            .fold((1.0_f64, 0.0_f64), |(lo, hi), &e| (lo.min(e), hi.max(e)));
-        Self { lowest, highest }
-    }
-
-    /// The rule that gives a ball–wall contact exactly the wall's coefficient `e`.
-    fn wall_rule(&self, e: f64) -> Result<CoefficientCombineRule, Unsupported> {
-        if e <= self.lowest {
-            Ok(CoefficientCombineRule::Min)
-        } else if e >= self.highest {
-            Ok(CoefficientCombineRule::Max)
-        } else {
-            Err(Unsupported(
-                "a wall or box restitution between the balls' smallest and largest",
-            ))
-        }
-    }
-}
-
-/// A collider with restitution `e` combined by `rule`, frictionless.
-fn surface(c: ColliderBuilder, e: f64, rule: CoefficientCombineRule) -> ColliderBuilder {
-    c.restitution(e as f32)
-        .restitution_combine_rule(rule)
-        .friction(0.0)
-        .friction_combine_rule(CoefficientCombineRule::Min)
 }
