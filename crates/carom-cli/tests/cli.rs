@@ -229,3 +229,65 @@ fn the_output_file_receives_the_lines() {
     let text = std::fs::read_to_string(out_path).unwrap();
     assert_eq!(text.lines().count(), 2, "one sample and the summary");
 }
+
+#[test]
+fn a_3d_stick_scene_runs_on_the_stepped_engine_forced_or_chosen() {
+    // Two balls meet off-centre and stick into a tumbling pair, which bounces off the
+    // walls of a box.
+    let path = scene_file(
+        "stick3d.toml",
+        r#"dim = 3
+[world]
+restitution = 0.0
+inelastic = "stick"
+[world.border]
+min = [-1.0, -1.0, -1.0]
+max = [1.0, 1.0, 1.0]
+[[balls]]
+pos = [-0.5, 0.0, 0.0]
+vel = [1.0, 0.0, 0.1]
+radius = 0.1
+mass = 1.0
+[[balls]]
+pos = [0.5, 0.1, 0.0]
+vel = [-1.0, 0.0, 0.0]
+radius = 0.15
+mass = 2.0
+"#,
+    );
+    let file = path.to_str().unwrap();
+    for engine in ["stepped", "auto"] {
+        let out = carom(&[
+            "run", file, "--engine", engine, "--until", "2", "--every", "1", "--events",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let lines = lines(&out);
+        let summary = &lines.last().unwrap()["summary"];
+        assert_eq!(summary["engine"], "stepped", "{summary}");
+        let pipeline = summary["pipeline"].as_array().unwrap();
+        assert!(pipeline.iter().any(|p| p == "response:stick"), "{summary}");
+        assert_eq!(summary["ball_ball"], 1, "{summary}");
+        // Momentum is kept through the stick; the walls then change it.
+        let stuck = lines.iter().find(|l| l["t"] == 1.0).unwrap();
+        let p: Vec<f64> = (0..3)
+            .map(|k| {
+                stuck["vel"][0][k].as_f64().unwrap() + 2.0 * stuck["vel"][1][k].as_f64().unwrap()
+            })
+            .collect();
+        let p0 = [1.0 - 2.0, 0.0, 0.1];
+        for k in 0..3 {
+            assert!((p[k] - p0[k]).abs() < 1e-12, "{p:?}");
+        }
+        // The members keep their distance.
+        let pos = |l: &serde_json::Value, i: usize| -> Vec<f64> {
+            (0..3).map(|k| l["pos"][i][k].as_f64().unwrap()).collect()
+        };
+        let (a, b) = (pos(stuck, 0), pos(stuck, 1));
+        let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        assert!((d - 0.25).abs() < 1e-9, "{d}");
+    }
+}

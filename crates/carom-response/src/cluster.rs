@@ -300,6 +300,29 @@ where
         }
     }
 
+    /// The cluster moving at `velocity` with angular momentum `angular_momentum` about its
+    /// centre (world frame), as an engine's integration of forces and torques sets them
+    /// (pose, mass and inertia unchanged).
+    ///
+    /// Debug builds assert finiteness.
+    #[inline]
+    #[must_use]
+    pub fn with_motion(&self, velocity: Vector<T, D>, angular_momentum: Angular<T, D>) -> Self {
+        debug_assert!(
+            velocity
+                .iter()
+                .chain(<Const<D> as Space<T, D>>::angular_as_slice(
+                    &angular_momentum
+                ))
+                .all(|x| x.finite())
+        );
+        Self {
+            velocity,
+            angular_momentum,
+            ..*self
+        }
+    }
+
     /// Fuses two clusters (or balls) that stick together: one rigid body with their
     /// total linear and angular momentum (see the module documentation).
     ///

@@ -3,9 +3,10 @@
 //! `carom run` lets the user force an engine, an integrator, a step or a broad phase;
 //! everything left on `auto` is decided here from the scene. The rule for the engine:
 //! the exact event-driven engine whenever the scene can be simulated exactly, the
-//! time-stepped engine otherwise (drag, or rigid clusters in 3D, whose torque-free
-//! tumbling has no closed form the event engine could use), or when the user asks for
-//! an integrator or a step. The engine then builds only the parts the scene uses and
+//! time-stepped engine otherwise (drag; stuck clusters in 3D, whose torque-free
+//! tumbling has no closed form the event engine could use, or under gravity, against
+//! boxes or in a periodic border), or when the user asks for an integrator or a step.
+//! The stepped engine runs every scene the format allows. The engine then builds only the parts the scene uses and
 //! names them in [`Simulation::pipeline`](crate::Simulation::pipeline).
 
 use core::fmt;
@@ -125,10 +126,7 @@ pub fn event_engine_limitation<T: Real, const D: usize>(
     if scene.world.drag > T::zero() {
         return Some("the scene has drag, which has no exact time of impact");
     }
-    let stick = scene.world.inelastic == Inelastic::Stick
-        && (scene.world.restitution == T::zero()
-            || scene.balls.iter().any(|b| b.restitution == Some(T::zero())));
-    if stick {
+    if can_stick(scene) {
         if D == 3 {
             return Some(
                 "stuck clusters tumble in 3D (torque-free precession), which has no closed form",
@@ -245,16 +243,6 @@ pub fn plan<T: Real, const D: usize>(
         )));
     }
     if engine == EngineKind::Stepped {
-        if can_stick(scene) {
-            return Err(PlanError(format!(
-                "world.inelastic = \"stick\": the stepped engine does not simulate stuck clusters{}",
-                if D == 2 {
-                    "; use --engine event (or auto)"
-                } else {
-                    ", and the event engine cannot tumble them in 3D: use inelastic = \"slide\""
-                }
-            )));
-        }
         stepped_broad_phase(scene, options.broad)?;
     }
     if engine == EngineKind::Event && matches!(options.broad, BroadChoice::Sap | BroadChoice::Kd) {

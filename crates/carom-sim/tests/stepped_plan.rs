@@ -5,7 +5,7 @@ mod common;
 
 use carom_geometry::Border;
 use carom_integrate::Integrator;
-use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan, stepped_broad_phase};
+use carom_sim::plan::{BroadChoice, EngineChoice, Plan, RunOptions, plan, stepped_broad_phase};
 use carom_sim::run::{RunSink, drive, sample_times};
 use carom_sim::scene::{BallSpec, BorderSpec, Inelastic, Scene, World};
 use carom_sim::scenes::classic;
@@ -167,28 +167,41 @@ fn bad_scenes_and_options_are_errors_naming_the_field() {
 }
 
 #[test]
-fn stick_scenes_are_refused_naming_world_inelastic() {
-    // 2D, forced onto the stepped engine: the planner points at the event engine.
-    let mut s = classic::head_on(1.0, 1.0, 1.0, -1.0, 0.0);
-    s.world.inelastic = Inelastic::Stick;
+fn stick_scenes_run_on_the_stepped_engine_and_auto_picks_it_where_the_event_engine_cannot() {
     let stepped = RunOptions {
         engine: EngineChoice::Stepped,
         ..RunOptions::default()
     };
-    let e = plan(&s, &stepped).unwrap_err();
-    assert!(e.0.starts_with("world.inelastic = \"stick\""), "{e}");
-    assert!(e.0.contains("--engine event"), "{e}");
-    // The engine itself refuses too, whatever plan it is given.
-    let slide = classic::head_on(1.0, 1.0, 1.0, -1.0, 0.0);
-    let p = plan(&slide, &stepped).unwrap();
+    let has_stick = |p: &Plan, s: &Scene<f64, 2>| {
+        let sim = build(s, p, Direction::Forward).unwrap();
+        sim.pipeline().iter().any(|n| n == "response:stick")
+    };
+    // 2D without gravity: auto keeps the exact engine; forced, the stepped engine runs it.
+    let mut s = classic::head_on(1.0, 1.0, 1.0, -1.0, 0.0);
+    s.world.inelastic = Inelastic::Stick;
     assert_eq!(
-        SteppedEngine::new(&s, &p, Direction::Forward)
-            .err()
-            .unwrap()
-            .field,
-        "world.inelastic"
+        plan(&s, &RunOptions::default()).unwrap().engine,
+        EngineKind::Event
     );
-    // 3D on auto: no engine can run it; the message says what to change.
+    let p = plan(&s, &stepped).unwrap();
+    assert_eq!(p.engine, EngineKind::Stepped);
+    assert!(has_stick(&p, &s));
+    // Under gravity the event engine cannot: auto says why and picks the stepped engine.
+    let mut falling = s.clone();
+    falling.world.gravity = Vector2::new(0.0, -9.81);
+    let p = plan(&falling, &RunOptions::default()).unwrap();
+    assert_eq!(p.engine, EngineKind::Stepped);
+    assert!(p.reason.contains("gravity"), "{}", p.reason);
+    let e = plan(
+        &falling,
+        &RunOptions {
+            engine: EngineChoice::Event,
+            ..RunOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.0.contains("--engine stepped"), "{e}");
+    // 3D on auto: the stepped engine, because clusters tumble.
     let mut s3 = classic::ball_drop::<3>(1.0, 0.0);
     s3.world.inelastic = Inelastic::Stick;
     s3.balls.push(BallSpec::new(
@@ -197,15 +210,18 @@ fn stick_scenes_are_refused_naming_world_inelastic() {
         0.1,
         1.0,
     ));
-    let e = plan(&s3, &RunOptions::default()).unwrap_err();
-    assert!(e.0.contains("inelastic = \"slide\""), "{e}");
+    let p = plan(&s3, &RunOptions::default()).unwrap();
+    assert_eq!(p.engine, EngineKind::Stepped);
+    assert!(p.reason.contains("3D"), "{}", p.reason);
+    assert!(build(&s3, &p, Direction::Forward).is_ok());
     // A per-ball restitution of 0 sticks too; restitution above 0 everywhere does not.
-    let mut s = slide.clone();
+    let mut s = classic::head_on(1.0, 1.0, 1.0, -1.0, 0.0);
     s.world.inelastic = Inelastic::Stick;
     s.world.restitution = 0.5;
-    assert!(plan(&s, &stepped).is_ok());
+    let p = plan(&s, &stepped).unwrap();
+    assert!(!has_stick(&p, &s));
     s.balls[0].restitution = Some(0.0);
-    assert!(plan(&s, &stepped).is_err());
+    assert!(has_stick(&p, &s));
 }
 
 /// A sink that keeps what `drive` hands it.

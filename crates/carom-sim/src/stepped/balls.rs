@@ -22,6 +22,7 @@
 use carom_math::{Real, Space, Vector};
 use nalgebra::Const;
 
+use super::clusters::FREE;
 use crate::engine::Angular;
 use crate::scene::{Scene, SceneError};
 
@@ -33,6 +34,8 @@ where
 {
     /// Radii.
     pub(crate) radius: Vec<T>,
+    /// Masses.
+    pub(crate) mass: Vec<T>,
     /// `1/m`.
     pub(crate) inverse_mass: Vec<T>,
     /// `1/I` of the ball about its centre (`I = f m r²`, disk or solid sphere).
@@ -60,6 +63,8 @@ where
     /// Resting on an immovable surface, directly or through other supported balls, in
     /// the current step (see `response`: shock propagation).
     pub(crate) supported: Vec<bool>,
+    /// The stuck cluster each ball belongs to, or [`FREE`] (see `clusters`).
+    pub(crate) cluster: Vec<u32>,
 }
 
 impl<T: Real, const D: usize> BallArrays<T, D>
@@ -78,6 +83,7 @@ where
         let zero_spin = <Const<D> as Space<T, D>>::angular_zero();
         let balls = Self {
             radius: scene.balls.iter().map(|b| b.radius).collect(),
+            mass: scene.balls.iter().map(|b| b.mass).collect(),
             inverse_mass: scene.balls.iter().map(|b| T::one() / b.mass).collect(),
             inverse_inertia: scene
                 .balls
@@ -99,6 +105,7 @@ where
             chord: vec![Vector::zeros(); n],
             version: vec![0; n],
             supported: vec![false; n],
+            cluster: vec![FREE; n],
         };
         let bad = |x: &T| !(x.finite() && *x > T::zero());
         let bad_mass = balls.inverse_mass.iter().position(bad);

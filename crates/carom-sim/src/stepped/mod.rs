@@ -2,8 +2,8 @@
 //! detection so that no ball passes through another ball, a box or a wall at any speed.
 //!
 //! For scenes an exact event-driven engine cannot serve (drag, arbitrary forces,
-//! kinematic paddles driven from Rust, 3D stick clusters) and for engine authors who know
-//! the game loop. Each step of length `h`:
+//! kinematic paddles driven from Rust, stuck clusters in 3D, under gravity, against boxes
+//! or in a periodic border) and for engine authors who know the game loop. Each step of length `h`:
 //!
 //! 1. **Integrate** every ball with carom-integrate's [`Stepper`] (any [`Integrator`]),
 //!    in parallel chunks. Each ball's motion within the step is the straight segment
@@ -18,6 +18,17 @@
 //!    and so on to the end of the step. A ball bouncing a thousand times between a box
 //!    and a wall within one step bounces a thousand times.
 //!
+//! **Stuck clusters** (`inelastic = "stick"`, 2D and 3D, see `clusters` and `stick`): a
+//! ball–ball contact with pair restitution 0 fuses the two bodies into one rigid body
+//! (carom-response's `RigidCluster`, linear and angular momentum kept). A cluster's
+//! centre of mass is stepped by the same integrator and forces as a ball, its orientation
+//! by the explicit midpoint rule on rotations with `ω = I_world⁻¹ L` (torque-free
+//! precession in 3D), and each member ball moves on the chord to its rigid place at the
+//! step's end, so the steps above serve members unchanged (members of one cluster are
+//! never tested against each other). A member's contact is a rigid-body impulse at the
+//! contact point; the cluster's rest of the step is integrated again and its members'
+//! chords follow; a cluster resting on surfaces is held on all of them at once.
+//!
 //! Everything that runs in parallel computes each ball or pair on its own and merges in
 //! a fixed order; the event loop is sequential with a total order on events. Results are
 //! bit-identical for any number of threads and across runs.
@@ -29,23 +40,26 @@
 //! measurements against rapier2d.
 
 mod balls;
+mod clusters;
 mod forces;
 mod narrow;
 mod obstacles;
 mod response;
 mod rest;
+mod stick;
 mod sweep;
 
 use std::collections::BinaryHeap;
 
 use carom_geometry::Border;
-use carom_integrate::{Bodies, Integrator, Stepper, TimeStep};
+use carom_integrate::{Bodies, ForceField, Integrator, Stepper, TimeStep};
 use carom_math::{Real, Space, Vector, ensure_finite_vector};
 use carom_toi::Direction;
 use nalgebra::Const;
 use rayon::prelude::*;
 
 use self::balls::BallArrays;
+use self::clusters::Clusters;
 use self::forces::WorldForces;
 use self::narrow::{Event, Narrow, Overflow, Pending, Target};
 use self::obstacles::BoxArrays;
@@ -117,6 +131,9 @@ where
     stepper: Stepper<T, D, WorldForces<T, D>>,
     rules: Rules<T, D>,
     rest: RestSets<T, D>,
+    clusters: Clusters<T, D>,
+    /// The balls the last contact changed (scratch).
+    changed: Vec<u32>,
     sweep: Sweep<T, D>,
     queue: BinaryHeap<Pending<T, D>>,
     chunk_events: Vec<Vec<Event<T, D>>>,
@@ -171,20 +188,12 @@ where
     /// The first rule of [`Scene::validate`] the scene breaks; `--dt` if the step is not
     /// finite and positive in this precision; `--broad` for a broad phase that cannot
     /// serve a periodic border; `world.border` for a periodic border too small for its
-    /// balls (two ball diameters must fit in half a period); `world.inelastic` for a
-    /// scene whose balls can stick ([`can_stick`]): this engine does not simulate stuck
-    /// clusters.
+    /// balls (two ball diameters must fit in half a period).
     pub fn new(scene: &Scene<T, D>, plan: &Plan, direction: Direction) -> Result<Self, SceneError> {
         scene.validate()?;
         let n = scene.balls.len();
         if u32::try_from(n + scene.boxes.len()).is_err() {
             return Err(SceneError::new("balls", "more than 2^32 balls and boxes"));
-        }
-        if can_stick(scene) {
-            return Err(SceneError::new(
-                "world.inelastic",
-                "\"stick\" clusters are not simulated by the stepped engine; use --engine event (2D) or inelastic = \"slide\"",
-            ));
         }
         let dt = plan.dt.unwrap_or(DEFAULT_DT);
         let h = T::lit(dt);
@@ -206,6 +215,7 @@ where
         };
         let periodic_reach = periodic_reach(scene, periodic.as_ref())?;
         let forces = WorldForces::new(world.gravity, world.drag, direction == Direction::Backward);
+        let drag = forces.closed_form().map_or_else(T::zero, |c| c.linear_drag);
         let stepper = Stepper::new(integrator, forces)
             .map_err(|e| SceneError::new("--integrator", e.to_string()))?;
         let rules = Rules::for_scene(scene, h)?;
@@ -220,6 +230,8 @@ where
             stepper,
             rules,
             rest: RestSets::new(n),
+            clusters: Clusters::new(drag),
+            changed: Vec::new(),
             sweep,
             queue: BinaryHeap::new(),
             chunk_events: Vec::new(),
@@ -269,6 +281,9 @@ where
         }
         p.push("ccd:time-of-impact-sub-steps".into());
         p.push("response:restitution".into());
+        if can_stick(scene) && n >= 2 {
+            p.push("response:stick".into());
+        }
         if scene.world.friction > T::zero() {
             p.push("response:friction".into());
         }
@@ -411,6 +426,8 @@ where
                 &mut b.supported,
             );
         }
+        self.clusters
+            .integrate(&mut self.balls, &self.stepper, t0, h);
     }
 
     fn narrow(&self, end: T) -> Narrow<'_, T, D> {
@@ -572,9 +589,12 @@ where
             }
     }
 
-    /// Processes one event; returns the balls it changed (1 or 2) and the collision to
-    /// report, if any.
-    fn process(&mut self, e: &Event<T, D>, h: T, t0: T) -> ([u32; 2], usize, Option<Collision<T>>) {
+    /// Processes one event: the balls it changed go to `self.changed` (a cluster changes
+    /// all its members); returns the collision to report, if any.
+    ///
+    /// # Errors
+    /// A fusion of two clusters that overflows the precision.
+    fn process(&mut self, e: &Event<T, D>, h: T, t0: T) -> Result<Option<Collision<T>>, SimError> {
         let i = e.ball as usize;
         let other = match e.target {
             Target::Ball(j) => j as usize,
@@ -587,60 +607,83 @@ where
                 self.gather(ball, e.time, out);
             }
         }
+        let in_cluster = |b: &BallArrays<T, D>, k: usize| Clusters::of(b, k).is_some();
+        let clustered = in_cluster(&self.balls, i) || in_cluster(&self.balls, other);
         let mut contacts = Contacts {
             balls: &mut self.balls,
             boxes: &self.boxes,
+            border: self.border.as_ref(),
             stepper: &self.stepper,
             rules: &self.rules,
             rest: &mut self.rest,
+            clusters: &mut self.clusters,
             touching: [(i, &touches[0]), (other, &touches[1])],
             h,
             t0,
         };
         let time = (t0 + e.time) * self.clock.sign + T::zero();
-        let (effect, changed, count, collision): (Effect, [u32; 2], usize, Collision<T>) =
-            match e.target {
-                Target::Ball(j) => (
-                    contacts.ball_ball(i, j as usize, &e.shift, e.time, &e.normal),
-                    [e.ball, j],
-                    2,
-                    Collision::BallBall {
-                        time,
-                        i,
-                        j: j as usize,
+        let stuck_error = |message: String| SimError {
+            time: time.to_f64(),
+            message,
+        };
+        let (effect, collision): (Effect, Collision<T>) = match e.target {
+            Target::Ball(j) => {
+                let j = j as usize;
+                let sticks = self.rules.stick
+                    && contacts.balls.restitution[i].min(contacts.balls.restitution[j])
+                        == T::zero();
+                let effect = if clustered || sticks {
+                    contacts
+                        .stuck_pair(i, j, &e.shift, e.time, &e.normal)
+                        .map_err(stuck_error)?
+                } else {
+                    contacts.ball_ball(i, j, &e.shift, e.time, &e.normal)
+                };
+                (effect, Collision::BallBall { time, i, j })
+            }
+            Target::Border => (
+                match Clusters::of(contacts.balls, i) {
+                    Some(c) => contacts.cluster_surface(c, i, Surface::Wall, &e.normal, e.time),
+                    None => contacts.ball_surface(i, Surface::Wall, &e.normal, e.time),
+                },
+                Collision::BallBorder { time, i },
+            ),
+            Target::Box(k) => {
+                let k = k as usize;
+                let surface = Surface::Box(k, self.boxes.vel[k]);
+                (
+                    match Clusters::of(contacts.balls, i) {
+                        Some(c) => contacts.cluster_surface(c, i, surface, &e.normal, e.time),
+                        None => contacts.ball_surface(i, surface, &e.normal, e.time),
                     },
-                ),
-                Target::Border => (
-                    contacts.ball_surface(i, Surface::Wall, &e.normal, e.time),
-                    [e.ball, e.ball],
-                    1,
-                    Collision::BallBorder { time, i },
-                ),
-                Target::Box(k) => {
-                    let k = k as usize;
-                    let v = self.boxes.vel[k];
-                    (
-                        contacts.ball_surface(i, Surface::Box(k, v), &e.normal, e.time),
-                        [e.ball, e.ball],
-                        1,
-                        Collision::BallBox { time, i, k },
-                    )
-                }
-            };
+                    Collision::BallBox { time, i, k },
+                )
+            }
+        };
         self.touches = touches;
+        self.changed.clear();
+        for ball in [i, other] {
+            match Clusters::of(&self.balls, ball) {
+                Some(c) => self
+                    .changed
+                    .extend_from_slice(&self.clusters.list[c].members),
+                None => self.changed.push(ball as u32),
+            }
+        }
+        self.changed.sort_unstable();
+        self.changed.dedup();
         self.stats.contacts += 1;
         if !effect.collided {
             self.stats.resting += 1;
         }
-        let report = effect.collided.then(|| {
+        Ok(effect.collided.then(|| {
             match collision {
                 Collision::BallBall { .. } => self.counters.ball_ball += 1,
                 Collision::BallBorder { .. } => self.counters.ball_border += 1,
                 Collision::BallBox { .. } => self.counters.ball_box += 1,
             }
             collision
-        });
-        (changed, count, report)
+        }))
     }
 
     /// The supports ball `i` touches at in-step time `s` (within `1e-9` of its radius):
@@ -723,8 +766,10 @@ where
         self.candidates = candidates;
     }
 
-    /// Stops every ball at in-step time `s` for the rest of the step (velocities kept).
-    fn freeze(&mut self, s: T, h: T) {
+    /// Stops every ball and cluster at in-step time `s` for the rest of the step
+    /// (velocities kept).
+    fn freeze(&mut self, s: T, h: T, t0: T) {
+        self.clusters.freeze(s, &self.stepper, t0);
         let b = &mut self.balls;
         for i in 0..b.len() {
             b.restart(i, s, h);
@@ -757,12 +802,12 @@ where
                 return Ok(WindowEnd::Budget(e.time));
             }
             *step_contacts += 1;
-            let (changed, count, report) = self.process(&e, h, t0);
-            if let Some(c) = report {
+            if let Some(c) = self.process(&e, h, t0)? {
                 observer.collision(&c);
             }
+            let changed = core::mem::take(&mut self.changed);
             let mut cut = false;
-            for &c in &changed[..count] {
+            for &c in &changed {
                 let c = c as usize;
                 self.balls.version[c] = self.balls.version[c].wrapping_add(1);
                 let path = path_box(
@@ -774,14 +819,16 @@ where
                 cut |= self.balls.chord[c].norm() * (b - e.time) > self.periodic_reach;
             }
             if cut {
+                self.changed = changed;
                 self.queue.clear();
                 self.stats.rebuilds += 1;
                 return Ok(WindowEnd::Cut(e.time));
             }
-            for (k, &c) in changed[..count].iter().enumerate() {
+            for (k, &c) in changed.iter().enumerate() {
                 self.predict_ball(c as usize, e.time, b, &changed[..k])
                     .map_err(|o| self.overflow(o, t0 + e.time))?;
             }
+            self.changed = changed;
         }
         Ok(WindowEnd::Done)
     }
@@ -814,13 +861,19 @@ where
         }
     }
 
-    /// Wraps every ball's segment into the periodic cell at in-step time `s`.
-    fn wrap(&mut self, s: T, h: T) {
+    /// Wraps every ball's segment into the periodic cell at in-step time `s`; a stuck
+    /// cluster wraps as a whole, when its centre of mass leaves the cell (its members may
+    /// then lie outside the cell: everything is computed with minimum images).
+    fn wrap(&mut self, s: T, h: T, t0: T) {
         let Some(border) = self.periodic else {
             return;
         };
         let b = &mut self.balls;
+        self.clusters.wrap(b, &border, s, h, &self.stepper, t0);
         for i in 0..b.len() {
+            if Clusters::of(b, i).is_some() {
+                continue;
+            }
             let x = b.position_at(i, s);
             let shift = border.wrap(&x) - x;
             if shift != Vector::<T, D>::zeros() {
@@ -870,11 +923,11 @@ where
                 WindowEnd::Done => b,
                 WindowEnd::Cut(s) => s,
                 WindowEnd::Budget(s) => {
-                    self.freeze(s, h);
+                    self.freeze(s, h, t0);
                     h
                 }
             };
-            self.wrap(a, h);
+            self.wrap(a, h, t0);
         }
         self.stats.steps += 1;
         self.stats.max_contacts_in_step = self.stats.max_contacts_in_step.max(step_contacts);

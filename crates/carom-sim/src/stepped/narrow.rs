@@ -33,6 +33,7 @@ use carom_toi::{Kinematics, Status, Toi, Window, ball_ball, ball_border, ball_ob
 use nalgebra::Const;
 
 use super::balls::BallArrays;
+use super::clusters::FREE;
 use super::obstacles::{BoxArrays, image_offsets};
 use super::sweep::{overlap, path_box};
 
@@ -201,6 +202,10 @@ where
     /// The first contact of balls `i < j` after `s`.
     pub(crate) fn ball_ball(&self, i: usize, j: usize, s: T) -> Prediction<T, D> {
         let b = self.balls;
+        if b.cluster[i] != FREE && b.cluster[i] == b.cluster[j] {
+            // Members of one rigid cluster never collide with each other.
+            return Ok(None);
+        }
         let (pi, pj) = (b.position_at(i, s), b.position_at(j, s));
         let shift = match self.periodic {
             Some(p) => (pi + p.minimum_image(&(pj - pi))) - pj,

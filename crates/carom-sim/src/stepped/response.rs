@@ -36,17 +36,19 @@
 //! After these, the pair no longer closes along its chords, so the same contact is not
 //! found again; the event loop goes on with the next one.
 
+use carom_geometry::Border;
 use carom_integrate::{ForceField, Stepper, TimeStep};
 use carom_math::{Real, Space, Vector};
 use carom_response::guard::{Bounce, CollapseGuard, RestingGuard};
-use carom_response::{Body, Coefficients, Contact, normal_velocity, resolve};
+use carom_response::{Body, Coefficients, Contact, Response, normal_velocity, resolve};
 use nalgebra::Const;
 
 use super::balls::BallArrays;
+use super::clusters::Clusters;
 use super::obstacles::BoxArrays;
 use super::rest::{RestSet, Support, Touch};
 use crate::engine::Angular;
-use crate::scene::{Scene, SceneError};
+use crate::scene::{Inelastic, Scene, SceneError};
 
 /// The rules of a scene's contacts.
 #[derive(Clone, Copy, Debug)]
@@ -68,6 +70,8 @@ pub(crate) struct Rules<T: Real, const D: usize> {
     /// what gravity adds in a step plus `64 ε` times the scene's speed scale (the fastest
     /// ball or box at the start).
     pub(crate) floor: T,
+    /// `inelastic = "stick"`: two balls whose pair restitution is 0 fuse (see `stick`).
+    pub(crate) stick: bool,
 }
 
 impl<T: Real, const D: usize> Rules<T, D> {
@@ -98,6 +102,7 @@ impl<T: Real, const D: usize> Rules<T, D> {
             collapse: CollapseGuard::elastic_below(collapse_speed).map_err(bad_step)?,
             support_speed: T::lit(2.0) * g * h,
             floor: T::lit(1e-6) * g * h + T::lit(64.0) * T::EPSILON * speed,
+            stick: world.inelastic == Inelastic::Stick,
         })
     }
 }
@@ -183,9 +188,13 @@ where
 {
     pub(crate) balls: &'a mut BallArrays<T, D>,
     pub(crate) boxes: &'a BoxArrays<T, D>,
+    /// The reflecting border, if any.
+    pub(crate) border: Option<&'a Border<T, D>>,
     pub(crate) stepper: &'a Stepper<T, D, F>,
     pub(crate) rules: &'a Rules<T, D>,
     pub(crate) rest: &'a mut RestSets<T, D>,
+    /// The stuck clusters (see `stick`).
+    pub(crate) clusters: &'a mut Clusters<T, D>,
     /// The supports the contact's balls touch now: `(ball, touches)` (gathered only
     /// under gravity; see `rest_on`).
     pub(crate) touching: [(usize, &'a [Touch<T, D>]); 2],
@@ -199,7 +208,7 @@ impl<T: Real, const D: usize, F: ForceField<T, D>> Contacts<'_, T, D, F>
 where
     Const<D>: Space<T, D>,
 {
-    fn body(&self, i: usize, v: Vector<T, D>, w: Angular<T, D>) -> Body<T, D> {
+    pub(super) fn body(&self, i: usize, v: Vector<T, D>, w: Angular<T, D>) -> Body<T, D> {
         let b = &*self.balls;
         Body::new_unchecked(
             b.inverse_mass[i],
@@ -223,7 +232,7 @@ where
 
     /// Applies a collision's new physical velocities to ball `i` and re-integrates it:
     /// it is no longer supported.
-    fn collide(&mut self, i: usize, s: T, v: Vector<T, D>, w: Angular<T, D>) {
+    pub(super) fn collide(&mut self, i: usize, s: T, v: Vector<T, D>, w: Angular<T, D>) {
         self.balls.seg_v[i] = v;
         self.balls.seg_w[i] = w;
         self.reintegrate(i);
@@ -258,7 +267,8 @@ where
             self.body(i, b.seg_v[i], b.seg_w[i]),
             self.body(j, b.seg_v[j], b.seg_w[j]),
         );
-        let approach = -normal_velocity(&bi, &bj, &contact);
+        let nominal = b.restitution[i].min(b.restitution[j]);
+        let (approach, r) = self.pair_collision(&bi, &bj, &contact, nominal);
         let slow = approach <= self.rules.support_speed;
         let down = self.rules.gravity.dot(&n);
         // Ball j holds ball i (or i holds j): it is supported, lies below along gravity
@@ -268,17 +278,6 @@ where
         let i_holds = b.supported[i] && down < T::zero() && b.chord[i].dot(&n) <= floor;
         // A slow contact onto a support is resting: no impulse, only the correction below.
         let onto_support = slow && (j_holds || i_holds);
-        let nominal = b.restitution[i].min(b.restitution[j]);
-        let e = self
-            .rules
-            .collapse
-            .restitution(nominal, approach, [T::INFINITY, T::INFINITY]);
-        let r = resolve(
-            &bi,
-            &bj,
-            &contact,
-            &Coefficients::new_unchecked(e, self.rules.friction),
-        );
         let effect = Effect {
             collided: r.applied() && !slow,
         };
@@ -387,6 +386,62 @@ where
         self.balls.supported[i] = true;
     }
 
+    /// The approach speed of two dynamic bodies at `contact` and their collision with
+    /// the pair restitution `nominal` through the collapse guard (elastic below what
+    /// gravity adds in a step).
+    pub(super) fn pair_collision(
+        &self,
+        a: &Body<T, D>,
+        b: &Body<T, D>,
+        contact: &Contact<T, D>,
+        nominal: T,
+    ) -> (T, Response<T, D>) {
+        let approach = -normal_velocity(a, b, contact);
+        let e = self
+            .rules
+            .collapse
+            .restitution(nominal, approach, [T::INFINITY, T::INFINITY]);
+        let r = resolve(
+            a,
+            b,
+            contact,
+            &Coefficients::new_unchecked(e, self.rules.friction),
+        );
+        (approach, r)
+    }
+
+    /// The collision of `body` (body `a`) with the immovable surface `other` at `contact`
+    /// (normal into the surface), or `None` for a support-sized approach (a resting
+    /// contact: only the correction of the chords) or a pair that does not close. The
+    /// resting guard decides between the surface's restitution `nominal` and rest.
+    pub(super) fn surface_collision(
+        &self,
+        body: &Body<T, D>,
+        other: &Body<T, D>,
+        contact: &Contact<T, D>,
+        nominal: T,
+    ) -> Option<Response<T, D>> {
+        let approach = -normal_velocity(body, other, contact);
+        if approach <= self.rules.support_speed {
+            return None;
+        }
+        let e = match self.rules.resting.decide(
+            approach,
+            nominal,
+            self.rules.gravity.dot(&contact.normal()),
+        ) {
+            Bounce::Rebound => nominal,
+            Bounce::Rest => T::zero(),
+        };
+        let r = resolve(
+            body,
+            other,
+            contact,
+            &Coefficients::new_unchecked(e, self.rules.friction),
+        );
+        r.applied().then_some(r)
+    }
+
     /// Ball `i` touching a wall or a box along `n` (from the ball into the surface) at `s`.
     pub(crate) fn ball_surface(
         &mut self,
@@ -415,28 +470,10 @@ where
             return Effect::default();
         };
         let ball = self.body(i, b.seg_v[i], b.seg_w[i]);
-        let approach = -normal_velocity(&ball, &other, &contact);
         let mut effect = Effect::default();
-        // A support-sized approach is a resting contact: only the correction below.
-        if approach > self.rules.support_speed {
-            let e = match self
-                .rules
-                .resting
-                .decide(approach, nominal, self.rules.gravity.dot(n))
-            {
-                Bounce::Rebound => nominal,
-                Bounce::Rest => T::zero(),
-            };
-            let r = resolve(
-                &ball,
-                &other,
-                &contact,
-                &Coefficients::new_unchecked(e, self.rules.friction),
-            );
-            if r.applied() {
-                effect.collided = true;
-                self.collide(i, s, r.velocity[0], r.angular_velocity[0]);
-            }
+        if let Some(r) = self.surface_collision(&ball, &other, &contact, nominal) {
+            effect.collided = true;
+            self.collide(i, s, r.velocity[0], r.angular_velocity[0]);
         }
         if (surface_velocity - self.balls.chord[i]).dot(n) < T::zero() && s < h {
             self.rest_on(i, support, n, surface_velocity, zero_spin, s);

@@ -1,0 +1,308 @@
+//! Stuck clusters in the time-stepped engine: balls fused by perfectly inelastic "stick"
+//! collisions (`inelastic = "stick"`, pair restitution 0), moving as rigid bodies, in 2D
+//! and 3D.
+//!
+//! A cluster is a carom-response [`RigidCluster`] (mass, centre of mass, orientation,
+//! inertia with each ball's own disk or sphere inertia plus parallel axes, velocity,
+//! angular momentum `L` about the centre), its members and their body-frame offsets `o`.
+//! Like a ball (see `balls`), it has a segment within the step: its rigid state `start`
+//! at in-step time `seg_t` and `end` at the step's end `h`. Each member ball's segment
+//! runs from where it is at `seg_t` to its rigid place at `h`,
+//!
+//! ```text
+//! x_end = c_end + R_end o,    v_end = v_end,com + ω_end × R_end o,    spin = ω_end,
+//! ```
+//!
+//! along its straight chord, which is what the continuous collision detection sweeps: all
+//! the broad- and narrow-phase machinery of single balls serves the members unchanged,
+//! and "no overlap along the chords" holds for them too. Members of one cluster are never
+//! tested against each other. At every step end the members are exactly (to rounding) in
+//! their rigid places, so the distances between them are kept.
+//!
+//! **The motion over a segment of length `τ`** ([`advance`]):
+//!
+//! * the centre of mass is stepped by the engine's integrator under the same field as a
+//!   ball (gravity, linear drag), so it keeps the integrator's order;
+//! * the angular momentum about the centre is constant without drag (no torque: gravity
+//!   acts at the centre of mass). The orientation follows `Ṙ = [ω]ₓ R` with
+//!   `ω = R I_body⁻¹ Rᵀ L` recomputed from the current orientation: in 3D an asymmetric
+//!   body precesses (its `ω` changes while `L` is kept). The update is the explicit
+//!   midpoint rule on rotations, `R½ = exp(ω(R₀) τ/2) R₀`, `R₁ = exp(ω(R½) τ) R₀`, with
+//!   the exponential map of a rotation vector (orthonormal to rounding at every step);
+//!   its local error is `O((|ω| τ)³)`, so the orientation and the rotational kinetic
+//!   energy `½ L·I_world⁻¹ L` are second-order accurate, with the exactly constant `L`.
+//!   In 2D `ω` is constant and the update is exact.
+//! * linear drag acts on each ball, `F_i = −b v_i` with `v_i = v + ω × a_i` (arms
+//!   `a_i = R o_i`). Summed: `F = −b (k v + ω × A)`, torque `τ = −b (J ω + A × v)`, with
+//!   `k` members, `A = Σ a_i` and `J = Σ (|a_i|² 𝟙 − a_i a_iᵀ)`. The integrator steps the
+//!   main term `−b k v` (the ball field with inverse mass `k/M`); the coupling `−b ω × A`
+//!   (zero when every member has the same mass) and the torque are added explicitly with
+//!   the values at the segment start: first order in `b τ / m`.
+
+use carom_geometry::Border;
+use carom_integrate::{ForceField, Stepper, TimeStep};
+use carom_math::{Real, Space, Vector};
+use carom_response::RigidCluster;
+use nalgebra::Const;
+
+use super::balls::BallArrays;
+use crate::engine::Angular;
+
+/// A member ball's cluster id when it is in no cluster.
+pub(crate) const FREE: u32 = u32::MAX;
+
+/// One rigid cluster of stuck balls and its segment within the step.
+#[derive(Clone, Debug)]
+pub(crate) struct StuckCluster<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    /// The rigid state at the segment start `seg_t`.
+    pub(crate) start: RigidCluster<T, D>,
+    /// The in-step time the segment starts at.
+    pub(crate) seg_t: T,
+    /// The rigid state at the end of the step (the state between steps).
+    pub(crate) end: RigidCluster<T, D>,
+    /// The member balls.
+    pub(crate) members: Vec<u32>,
+    /// Their offsets from the centre of mass, in the body frame.
+    pub(crate) offsets: Vec<Vector<T, D>>,
+}
+
+/// Every cluster of the run, in the order they formed (a fusion of two clusters keeps
+/// the lower index and moves the last cluster into the freed slot: deterministic).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Clusters<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    pub(crate) list: Vec<StuckCluster<T, D>>,
+    /// The signed linear drag coefficient of the run (negative backward: see `forces`).
+    pub(crate) drag: T,
+}
+
+/// The arm `R o` of a member and its velocity `v + ω × R o` on `rigid`.
+#[inline]
+pub(crate) fn member_motion<T: Real, const D: usize>(
+    rigid: &RigidCluster<T, D>,
+    offset: &Vector<T, D>,
+) -> (Vector<T, D>, Vector<T, D>, Angular<T, D>)
+where
+    Const<D>: Space<T, D>,
+{
+    let arm = rigid.orientation() * offset;
+    let w = rigid.angular_velocity();
+    (
+        arm,
+        rigid.velocity() + <Const<D> as Space<T, D>>::angular_cross(&w, &arm),
+        w,
+    )
+}
+
+/// The rigid body `rigid` (members at `offsets`) advanced by `tau` from internal time `t`
+/// under the stepper's field and the signed linear `drag` (see the module documentation).
+pub(crate) fn advance<T: Real, const D: usize, F: ForceField<T, D>>(
+    rigid: &RigidCluster<T, D>,
+    offsets: &[Vector<T, D>],
+    stepper: &Stepper<T, D, F>,
+    drag: T,
+    t: T,
+    tau: T,
+) -> RigidCluster<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    let Ok(dt) = TimeStep::new(tau) else {
+        return *rigid;
+    };
+    let mass = rigid.mass();
+    let (mut c, mut v) = (rigid.center(), rigid.velocity());
+    let mut unused_spin = <Const<D> as Space<T, D>>::angular_zero();
+    let drag_share = T::from_count(offsets.len()) / mass;
+    stepper.step_ball(&mut c, &mut v, &mut unused_spin, drag_share, t, dt);
+    let r0 = rigid.orientation();
+    let l0 = rigid.angular_momentum();
+    let w0 = rigid.angular_velocity();
+    let mut l1 = l0;
+    if drag != T::zero() {
+        let mut j = <Const<D> as Space<T, D>>::inertia_isotropic(T::zero());
+        let mut a = Vector::<T, D>::zeros();
+        for o in offsets {
+            let arm = r0 * o;
+            j = j + <Const<D> as Space<T, D>>::inertia_parallel_axis(T::one(), &arm);
+            a += arm;
+        }
+        let torque = <Const<D> as Space<T, D>>::inertia_apply(&j, &w0)
+            + <Const<D> as Space<T, D>>::cross(&a, &rigid.velocity());
+        l1 = l0 - torque * (drag * tau);
+        v -= <Const<D> as Space<T, D>>::angular_cross(&w0, &a) * (drag * tau / mass);
+    }
+    // Explicit midpoint on SO(D): ω at the half-step orientation and half-step momentum.
+    let half = T::lit(0.5);
+    let r_half = <Const<D> as Space<T, D>>::rotation_from_angular(&w0, tau * half) * r0;
+    let w_half = rigid
+        .with_pose(rigid.center(), r_half)
+        .with_motion(rigid.velocity(), (l0 + l1) * half)
+        .angular_velocity();
+    let r1 = <Const<D> as Space<T, D>>::rotation_from_angular(&w_half, tau) * r0;
+    rigid.with_pose(c, r1).with_motion(v, l1)
+}
+
+impl<T: Real, const D: usize> StuckCluster<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// The rigid state at in-step time `s >= seg_t` (the step started at internal time `t0`).
+    pub(crate) fn at<F: ForceField<T, D>>(
+        &self,
+        s: T,
+        stepper: &Stepper<T, D, F>,
+        drag: T,
+        t0: T,
+    ) -> RigidCluster<T, D> {
+        if s <= self.seg_t {
+            return self.start;
+        }
+        advance(
+            &self.start,
+            &self.offsets,
+            stepper,
+            drag,
+            t0 + self.seg_t,
+            s - self.seg_t,
+        )
+    }
+
+    /// Starts a new segment at `s` from the rigid state `rigid` (the state at `s`,
+    /// possibly after an impulse): the members restart where their chords are at `s`,
+    /// moving at their rigid velocities, and the cluster and its members are integrated
+    /// to the end of the step `h`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn restart_from<F: ForceField<T, D>>(
+        &mut self,
+        balls: &mut BallArrays<T, D>,
+        rigid: RigidCluster<T, D>,
+        s: T,
+        h: T,
+        stepper: &Stepper<T, D, F>,
+        drag: T,
+        t0: T,
+    ) {
+        self.restart_members(balls, &rigid, s, h);
+        self.start = rigid;
+        self.seg_t = s;
+        self.end = advance(&rigid, &self.offsets, stepper, drag, t0 + s, h - s);
+        self.set_member_ends(balls, h);
+    }
+
+    /// Restarts every member's segment at `s` where its chord is, moving at its velocity
+    /// on `rigid` (the cluster's state at `s`); the ends are unchanged.
+    pub(crate) fn restart_members(
+        &self,
+        balls: &mut BallArrays<T, D>,
+        rigid: &RigidCluster<T, D>,
+        s: T,
+        h: T,
+    ) {
+        for (&m, o) in self.members.iter().zip(&self.offsets) {
+            let m = m as usize;
+            balls.restart(m, s, h);
+            let (_, v, w) = member_motion(rigid, o);
+            balls.seg_v[m] = v;
+            balls.seg_w[m] = w;
+        }
+    }
+
+    /// Sets every member's segment end to its rigid place at the end of the step.
+    pub(crate) fn set_member_ends(&self, balls: &mut BallArrays<T, D>, h: T) {
+        for (&m, o) in self.members.iter().zip(&self.offsets) {
+            let (arm, v, w) = member_motion(&self.end, o);
+            balls.set_end(m as usize, h, self.end.center() + arm, v, w);
+        }
+    }
+}
+
+impl<T: Real, const D: usize> Clusters<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// No clusters yet, for a run with the signed linear `drag` coefficient.
+    pub(crate) fn new(drag: T) -> Self {
+        Self {
+            list: Vec::new(),
+            drag,
+        }
+    }
+
+    /// Integrates every cluster over the whole step `h` from internal time `t0` and sets
+    /// its members' segments (after the balls' own integration, which it overrides).
+    pub(crate) fn integrate<F: ForceField<T, D>>(
+        &mut self,
+        balls: &mut BallArrays<T, D>,
+        stepper: &Stepper<T, D, F>,
+        t0: T,
+        h: T,
+    ) {
+        let drag = self.drag;
+        for cluster in &mut self.list {
+            let rigid = cluster.end;
+            cluster.start = rigid;
+            cluster.seg_t = T::zero();
+            cluster.end = advance(&rigid, &cluster.offsets, stepper, drag, t0, h);
+            cluster.set_member_ends(balls, h);
+        }
+    }
+
+    /// Stops every cluster at in-step time `s` for the rest of the step (velocity and
+    /// angular momentum kept), as the event budget does to every ball.
+    pub(crate) fn freeze<F: ForceField<T, D>>(&mut self, s: T, stepper: &Stepper<T, D, F>, t0: T) {
+        let drag = self.drag;
+        for cluster in &mut self.list {
+            let rigid = cluster.at(s, stepper, drag, t0);
+            cluster.start = rigid;
+            cluster.seg_t = s;
+            cluster.end = rigid;
+        }
+    }
+
+    /// Moves every cluster whose centre of mass at in-step time `s` left the periodic
+    /// cell `border` by the period(s) that bring it back, members included.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn wrap<F: ForceField<T, D>>(
+        &mut self,
+        balls: &mut BallArrays<T, D>,
+        border: &Border<T, D>,
+        s: T,
+        h: T,
+        stepper: &Stepper<T, D, F>,
+        t0: T,
+    ) {
+        let drag = self.drag;
+        for cluster in &mut self.list {
+            let rigid = cluster.at(s, stepper, drag, t0);
+            let c = rigid.center();
+            let shift = border.wrap(&c) - c;
+            if shift == Vector::<T, D>::zeros() {
+                continue;
+            }
+            cluster.restart_members(balls, &rigid, s, h);
+            for &m in &cluster.members {
+                balls.seg_x[m as usize] += shift;
+                balls.pos[m as usize] += shift;
+            }
+            cluster.start = rigid.with_pose(c + shift, rigid.orientation());
+            cluster.seg_t = s;
+            let end = &cluster.end;
+            cluster.end = end.with_pose(end.center() + shift, end.orientation());
+        }
+    }
+
+    /// The cluster of member `i`, if any.
+    #[inline]
+    pub(crate) fn of(balls: &BallArrays<T, D>, i: usize) -> Option<usize> {
+        match balls.cluster[i] {
+            FREE => None,
+            c => Some(c as usize),
+        }
+    }
+}
