@@ -697,3 +697,30 @@ fn a_spinning_cluster_wraps_around_a_periodic_border_as_a_whole() {
         "{centre} vs {unwrapped}"
     );
 }
+
+#[test]
+fn a_cluster_spanning_half_a_periodic_box_stops_the_run_naming_the_border() {
+    // The stuck pair spans 2 × 0.279 m about its centre of mass (ball 0 is 0.179 m from
+    // it, radius 0.1): in a periodic box 1 m high its members could meet their own
+    // images, so the fusion is an error naming the border, not a silent wrong run.
+    let mut s = pair::<2>(0.12);
+    s.world.border = Some(BorderSpec {
+        border: Border::new(Vector2::new(-1.0, -0.5), Vector2::new(2.0, 0.5)).unwrap(),
+        restitution: 1.0,
+        periodic: true,
+    });
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    let err = sim
+        .advance_to(2.0, &mut Recorder::default())
+        .expect_err("the fused pair spans more than half the box");
+    assert!(err.message.starts_with("world.border"), "{}", err.message);
+    // The same pair in a box 3 m high runs.
+    let mut roomy = s.clone();
+    roomy.world.border = Some(BorderSpec {
+        border: Border::new(Vector2::new(-1.0, -1.5), Vector2::new(2.0, 1.5)).unwrap(),
+        restitution: 1.0,
+        periodic: true,
+    });
+    let mut sim = stepped(&roomy, Integrator::SemiImplicitEuler, DT);
+    sim.advance_to(2.0, &mut Recorder::default()).unwrap();
+}

@@ -79,6 +79,9 @@ where
     pub(crate) list: Vec<StuckCluster<T, D>>,
     /// The signed linear drag coefficient of the run (negative backward: see `forces`).
     pub(crate) drag: T,
+    /// The smallest side of a periodic border: a cluster may span at most half of it
+    /// (see [`Clusters::check_span`]).
+    pub(crate) period: Option<T>,
 }
 
 /// The arm `R o` of a member and its velocity `v + ω × R o` on `rigid`.
@@ -227,10 +230,27 @@ where
     Const<D>: Space<T, D>,
 {
     /// No clusters yet, for a run with the signed linear `drag` coefficient.
-    pub(crate) fn new(drag: T) -> Self {
+    pub(crate) fn new(drag: T, period: Option<T>) -> Self {
         Self {
             list: Vec::new(),
             drag,
+            period,
+        }
+    }
+
+    /// Refuses a cluster that spans half the smallest period or more: its members could
+    /// then meet their own periodic images and the minimum image of a partner would be
+    /// ambiguous, neither of which the engine models, so the run stops with an error
+    /// naming the border instead of going on silently wrong. `span` is twice the largest
+    /// distance from the centre of mass to a member's surface.
+    pub(crate) fn check_span(&self, members: usize, span: T) -> Result<(), String> {
+        match self.period {
+            Some(period) if span + span >= period => Err(format!(
+                "world.border: a stuck cluster of {members} balls spans {:e}, at least half the periodic box's smallest side {:e}; its members would meet their own images, which the stepped engine does not model (make the box larger or the run shorter)",
+                span.to_f64(),
+                period.to_f64()
+            )),
+            _ => Ok(()),
         }
     }
 

@@ -230,7 +230,7 @@ where
             stepper,
             rules,
             rest: RestSets::new(n),
-            clusters: Clusters::new(drag),
+            clusters: Clusters::new(drag, periodic.as_ref().map(|b| b.extents().min())),
             changed: Vec::new(),
             sweep,
             queue: BinaryHeap::new(),

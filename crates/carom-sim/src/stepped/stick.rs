@@ -473,6 +473,12 @@ where
                 }
             }
         }
+        let reach = members
+            .iter()
+            .zip(&offsets)
+            .map(|(&m, o)| o.norm() + self.balls.radius[m as usize])
+            .fold(T::zero(), T::max);
+        self.clusters.check_span(members.len(), reach + reach)?;
         if *shift != Vector::<T, D>::zeros() {
             let moved = match b {
                 Side::Ball(j) => vec![j as u32],
