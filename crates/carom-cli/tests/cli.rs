@@ -244,7 +244,10 @@ fn rejected(args: &[&str]) -> String {
 fn report_options_are_checked_before_anything_runs() {
     assert!(rejected(&["report", "--fast"]).contains("--fast"));
     let both = rejected(&["report", "--quick", "--full"]);
-    assert!(both.contains("--quick") && both.contains("--full"), "{both}");
+    assert!(
+        both.contains("--quick") && both.contains("--full"),
+        "{both}"
+    );
     assert!(rejected(&["report", "--out"]).contains("--out"));
     assert!(rejected(&["report", "extra"]).contains("extra"));
     // --help lists the options and runs nothing.

@@ -17,6 +17,16 @@ use carom_broad::{
 use crate::model::BroadPhaseRow;
 use crate::timing::{Sampling, median_per_call};
 
+/// A peer's broad phase (parry's BVH, [`crate::peer::parry`]) in `D` dimensions.
+pub trait Peer<const D: usize> {
+    /// One frame on `scene` (rebuilt, or refitted when `coherent` and a tree exists);
+    /// returns the number of pairs it reports.
+    fn frame(&mut self, scene: &Scene<f64, D>, coherent: bool) -> usize;
+}
+
+/// The peer's name in the rows.
+pub const PEER: &str = "parry-bvh";
+
 /// The broad phases measured, by their names in the rows.
 pub const METHODS: [&str; 5] = ["sap", "kd", "grid", "hashed", "brute"];
 
@@ -61,7 +71,12 @@ pub fn scene_name(dim: usize, dist: Distribution, coherent: bool) -> String {
     format!("{dim}D {} {frames}", dist.name())
 }
 
-fn make_phase<const D: usize>(name: &str, coherent: bool) -> Box<dyn ParallelBroadPhase<f64, D>> {
+/// The broad phase named `name` (one of [`METHODS`]) as the report runs it: sweep-and-prune
+/// sorts incrementally on coherent frames and by radix sort on one-shot ones.
+pub fn make_phase<const D: usize>(
+    name: &str,
+    coherent: bool,
+) -> Box<dyn ParallelBroadPhase<f64, D>> {
     match name {
         // Incremental insertion sort pays off only when frames are coherent.
         "sap" if coherent => Box::new(SweepAndPrune::new()),
@@ -90,13 +105,14 @@ fn frame<const D: usize>(
 }
 
 /// Every broad phase on one `D`-dimensional scene of `n` balls: a row per method and
-/// thread count (1, and 2 on `two`).
+/// thread count (1, and 2 on `two`), and one for `peer` (1 thread) when given.
 pub fn case<const D: usize>(
     dist: Distribution,
     n: usize,
     coherent: bool,
     sampling: Sampling,
     two: &rayon::ThreadPool,
+    peer: Option<Box<dyn Peer<D>>>,
 ) -> Vec<BroadPhaseRow> {
     let first = dist.scene::<D>(n, 1);
     let second = if coherent {
@@ -135,6 +151,18 @@ pub fn case<const D: usize>(
                 ns_per_ball: d.as_secs_f64() * 1e9 / n as f64,
             });
         }
+    }
+    if let Some(mut peer) = peer {
+        let d = median_per_call(sampling, |k| {
+            peer.frame(frames[k % 2], coherent);
+        });
+        rows.push(BroadPhaseRow {
+            method: PEER.to_owned(),
+            scene,
+            n,
+            threads: 1,
+            ns_per_ball: d.as_secs_f64() * 1e9 / n as f64,
+        });
     }
     rows
 }
@@ -176,13 +204,27 @@ mod tests {
             budget: Duration::ZERO,
         };
         let two = crate::throughput::pool(2).unwrap();
-        let rows = case::<2>(Distribution::Uniform(0.1), 500, true, sampling, &two);
+        let rows = case::<2>(Distribution::Uniform(0.1), 500, true, sampling, &two, None);
         // Four methods on 1 and 2 threads, brute force on 1.
         assert_eq!(rows.len(), 9);
         assert!(rows.iter().all(|r| r.ns_per_ball > 0.0 && r.n == 500));
         assert!(rows.iter().all(|r| r.scene == "2D uniform0.1 coherent"));
-        let rows = case::<3>(Distribution::Clustered, 2000, false, sampling, &two);
+        let rows = case::<3>(Distribution::Clustered, 2000, false, sampling, &two, None);
         assert_eq!(rows.len(), 8, "no brute force above {BRUTE_MAX}");
         assert_eq!(rows[0].scene, "3D clustered one-shot");
+        #[cfg(feature = "rapier")]
+        {
+            let peer = Box::new(crate::peer::parry::ParryBvh3::default());
+            let rows = case::<3>(
+                Distribution::Clustered,
+                300,
+                true,
+                sampling,
+                &two,
+                Some(peer),
+            );
+            let last = rows.last().unwrap();
+            assert_eq!((last.method.as_str(), last.threads), (PEER, 1));
+        }
     }
 }

@@ -244,6 +244,24 @@ fn tasks(config: &Config) -> Vec<Task> {
     tasks
 }
 
+/// parry's 2D BVH when the peers are built (feature `rapier`), `None` otherwise.
+#[cfg_attr(feature = "rapier", expect(clippy::unnecessary_wraps))]
+fn peer_bvh_2d() -> Option<Box<dyn broad::Peer<2>>> {
+    #[cfg(feature = "rapier")]
+    return Some(Box::new(peer::parry::ParryBvh2::default()));
+    #[cfg(not(feature = "rapier"))]
+    None
+}
+
+/// parry's 3D BVH when the peers are built (feature `rapier`), `None` otherwise.
+#[cfg_attr(feature = "rapier", expect(clippy::unnecessary_wraps))]
+fn peer_bvh_3d() -> Option<Box<dyn broad::Peer<3>>> {
+    #[cfg(feature = "rapier")]
+    return Some(Box::new(peer::parry::ParryBvh3::default()));
+    #[cfg(not(feature = "rapier"))]
+    None
+}
+
 /// Measures what `config` asks for into a [`Report`] (nothing written).
 ///
 /// # Errors
@@ -289,11 +307,15 @@ pub fn measure(config: &Config, progress: &dyn Fn(Progress<'_>)) -> Result<Repor
                 dist,
                 n,
                 coherent,
-            } => report.broad_phase.extend(if dim == 2 {
-                broad::case::<2>(dist, n, coherent, config.broad_sampling, &two)
-            } else {
-                broad::case::<3>(dist, n, coherent, config.broad_sampling, &two)
-            }),
+            } => {
+                let sampling = config.broad_sampling;
+                let rows = if dim == 2 {
+                    broad::case::<2>(dist, n, coherent, sampling, &two, peer_bvh_2d())
+                } else {
+                    broad::case::<3>(dist, n, coherent, sampling, &two, peer_bvh_3d())
+                };
+                report.broad_phase.extend(rows);
+            }
         }
     }
     progress(Progress {

@@ -110,6 +110,7 @@ fn broad_plots(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, ReportError>
             .collect();
         let methods: Vec<&str> = crate::broad::METHODS
             .into_iter()
+            .chain([crate::broad::PEER])
             .filter(|m| rows.iter().any(|r| r.method == *m))
             .collect();
         let series = methods
@@ -425,7 +426,9 @@ fn broad_table(md: &mut String, report: &Report, plots: &Plots) {
          pays per step); median frame time per ball, lower is better. One-shot frames jump \
          between unrelated scenes, coherent frames move every ball by 1 % of its radius. \
          sap = sweep-and-prune, kd = k-d tree, grid = dense uniform grid, hashed = hashed \
-         grid, brute = all pairs (to 1,000 balls).\n"
+         grid, brute = all pairs (to 1,000 balls); parry-bvh = parry 0.31's BVH (`f32`, \
+         rebuilt one-shot, refitted coherent), the peer, which reports overlapping boxes \
+         unsorted where carom's phases report exact ball pairs, sorted.\n"
     );
     let _ = writeln!(
         md,

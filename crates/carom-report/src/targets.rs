@@ -8,7 +8,7 @@
 
 use std::fmt::Write as _;
 
-use crate::broad::RANDOM_BOXES_SCENE;
+use crate::broad::{PEER, RANDOM_BOXES_SCENE};
 use crate::model::{BroadPhaseRow, Report, ThroughputRow};
 use crate::throughput::{EVENT_2D_SCENE, EVENT_3D_SCENE, STEPPED_SCENE, engine};
 
@@ -234,7 +234,8 @@ fn event_checks(report: &Report, out: &mut Vec<Check>) {
     }
 }
 
-/// The fastest one-thread row of each scene among `rows` at the scene's largest size.
+/// The fastest carom row on one thread of `scene` at its largest size, with the same
+/// method's 2-thread row.
 fn fastest_at_largest<'a>(
     rows: &'a [BroadPhaseRow],
     scene: &str,
@@ -246,7 +247,7 @@ fn fastest_at_largest<'a>(
         .max()?;
     let best = rows
         .iter()
-        .filter(|r| r.scene == scene && r.n == n && r.threads == 1)
+        .filter(|r| r.scene == scene && r.n == n && r.threads == 1 && r.method != PEER)
         .min_by(|a, b| a.ns_per_ball.total_cmp(&b.ns_per_ball))?;
     let two = rows
         .iter()
@@ -260,13 +261,20 @@ fn broad_checks(report: &Report, out: &mut Vec<Check>) {
         let Some((best, two)) = fastest_at_largest(&report.broad_phase, &scene) else {
             continue;
         };
+        let peer = report
+            .broad_phase
+            .iter()
+            .find(|r| r.scene == scene && r.n == best.n && r.method == PEER);
         out.push(Check {
             measure: format!(
                 "broad phase, {scene} N = {}, 1 thread: best ns per ball",
                 count(best.n)
             ),
             carom: format!("{:.1} ns ({})", best.ns_per_ball, best.method),
-            reference: "–".to_owned(),
+            reference: peer.map_or_else(
+                || "–".to_owned(),
+                |p| format!("parry BVH {:.1} ns (box pairs, unsorted)", p.ns_per_ball),
+            ),
             target: format!("< {BROAD_COHERENT_NS} ns at N = {}", count(BROAD_N)),
             verdict: verdict(best.ns_per_ball < BROAD_COHERENT_NS, best.n, BROAD_N),
         });

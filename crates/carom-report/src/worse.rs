@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use crate::broad::PEER;
 use crate::model::Report;
 use crate::targets::{self, EDMD, count, ms};
 use crate::throughput::engine;
@@ -84,6 +85,31 @@ fn event(report: &Report, out: &mut Vec<String>) {
     }
 }
 
+/// Broad-phase scenes and sizes where parry's BVH is faster than carom's fastest broad
+/// phase (both on one thread).
+fn broad(report: &Report, out: &mut Vec<String>) {
+    for p in report.broad_phase.iter().filter(|r| r.method == PEER) {
+        let best = report
+            .broad_phase
+            .iter()
+            .filter(|r| r.scene == p.scene && r.n == p.n && r.threads == 1 && r.method != PEER)
+            .min_by(|a, b| a.ns_per_ball.total_cmp(&b.ns_per_ball));
+        if let Some(b) = best
+            && b.ns_per_ball > p.ns_per_ball
+        {
+            out.push(format!(
+                "Broad phase, {} N = {} on 1 thread: parry's BVH {:.1} ns per ball against carom's fastest ({}) {:.1} ns ({:.2}× slower; parry reports box pairs unsorted, carom exact ball pairs sorted).",
+                p.scene,
+                count(p.n),
+                p.ns_per_ball,
+                b.method,
+                b.ns_per_ball,
+                b.ns_per_ball / p.ns_per_ball
+            ));
+        }
+    }
+}
+
 /// Work-precision points of rapier2d that no carom method matches on both axes (as
 /// accurate and as fast).
 fn work_precision(report: &Report, out: &mut Vec<String>) {
@@ -117,6 +143,7 @@ pub fn where_carom_is_worse(report: &Report) -> Vec<String> {
     let mut out = Vec::new();
     stepped(report, &mut out);
     event(report, &mut out);
+    broad(report, &mut out);
     work_precision(report, &mut out);
     for s in report.stability.iter().filter(|s| !s.pass) {
         out.push(format!("Stability case failed: {} ({}).", s.case, s.figure));
