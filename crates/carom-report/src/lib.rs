@@ -188,7 +188,7 @@ impl Task {
     fn describe(self, config: &Config) -> String {
         match self {
             Self::Stepped { n, threads } => format!(
-                "stepped engine and rapier2d, gas N = {}, {threads} thread(s)",
+                "stepped engine + rapier2d, gas N = {}, {threads} thread(s)",
                 targets::count(n)
             ),
             Self::Event { dim } => format!(

@@ -18,7 +18,18 @@ impl Machine {
             unix_time: SystemTime::now()
                 .duration_since(UNIX_EPOCH)
                 .map_or(0, |d| d.as_secs()),
+            load_average: std::fs::read_to_string("/proc/loadavg")
+                .ok()
+                .and_then(|text| text.split_whitespace().next()?.parse().ok()),
         }
+    }
+
+    /// `true` when other work held a noticeable share of the CPUs as the report started
+    /// (load average above a quarter of the CPUs): its timings are inflated and its
+    /// 2-thread speedups understated.
+    pub fn busy(&self) -> bool {
+        self.load_average
+            .is_some_and(|load| load > 0.25 * self.cpus as f64)
     }
 
     /// The report's date, `YYYY-MM-DD HH:MM UTC`.

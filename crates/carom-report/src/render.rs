@@ -252,6 +252,16 @@ fn header(md: &mut String, report: &Report) {
          noisy, ratios measured in the same run less so. docs/benchmarks.md says how to \
          reproduce each figure. `report.json` holds every row."
     );
+    if m.busy() {
+        let _ = writeln!(
+            md,
+            "\n**The machine was busy:** its load average was {:.1} on {} CPUs when the report \
+             started, so other work shared the cores. Timings are inflated and 2-thread \
+             speedups understated; rerun on a quiet machine before quoting them.",
+            m.load_average.unwrap_or(0.0),
+            m.cpus
+        );
+    }
     let has_rapier = report.throughput.iter().any(|r| r.engine == engine::RAPIER)
         || report
             .work_precision

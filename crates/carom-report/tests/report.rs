@@ -142,6 +142,7 @@ fn hand_built() -> Report {
             carom_version: "0.1.0".into(),
             optimized: true,
             unix_time: 1_700_000_000,
+            load_average: Some(1.5),
         },
         throughput: vec![
             stepped("carom-stepped", 10_000, 1, 2.0, 1e-15),
@@ -262,6 +263,7 @@ fn the_markdown_lists_where_carom_is_worse_from_the_rows() {
     );
     let md = carom_report::render::markdown(&report, &carom_report::render::Plots::default());
     assert!(md.contains("2023-11-14 22:13 UTC"));
+    assert!(md.contains("**The machine was busy:** its load average was 1.5 on 2 CPUs"));
     assert!(md.contains("| speed 1e6 m/s | **FAIL** | tunnelled |"));
     assert!(
         md.contains("| 10,000 | 1 | 2.00 ms | 12.0 ms | 6.0× | +1.0e-15 | -1.9e-1 |"),
