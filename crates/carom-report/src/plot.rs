@@ -129,8 +129,9 @@ pub fn draw(chart: &Chart, path: &Path) -> Result<(), ReportError> {
         path: path.to_owned(),
         message: e.to_string(),
     };
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    let root = SVGBackend::new(path, (1180, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let (plot_area, legend_area) = root.split_horizontally(860);
     let xs = range(
         chart
             .series
@@ -145,10 +146,11 @@ pub fn draw(chart: &Chart, path: &Path) -> Result<(), ReportError> {
         .chain(chart.references.iter().map(|r| r.0));
     if chart.log_y {
         let ys = range(ys, true).log_scale();
-        draw_on(&root, chart, xs, ys).map_err(|e| fail(&e))?;
+        draw_on(&plot_area, chart, xs, ys).map_err(|e| fail(&e))?;
     } else {
-        draw_on(&root, chart, xs, range(ys, false)).map_err(|e| fail(&e))?;
+        draw_on(&plot_area, chart, xs, range(ys, false)).map_err(|e| fail(&e))?;
     }
+    draw_legend(&legend_area, chart).map_err(|e| fail(&e))?;
     root.present().map_err(|e| fail(&e))
 }
 
@@ -178,43 +180,66 @@ where
         .axis_desc_style(("sans-serif", 15))
         .light_line_style(RGBColor(235, 235, 235))
         .draw()?;
-    for (k, (value, label)) in chart.references.iter().enumerate() {
-        let style = PALETTE[6].mix(0.6 - 0.2 * k.min(1) as f64).stroke_width(1);
+    for (k, (value, _)) in chart.references.iter().enumerate() {
+        let style = reference_style(k);
         c.draw_series(DashedLineSeries::new(
             [(xs.start, *value), (xs.end, *value)],
             3,
             6,
             style,
-        ))?
-        .label(label.as_str())
-        .legend(move |(x, y)| DashedPathElement::new([(x, y), (x + 24, y)], 3, 6, style));
+        ))?;
     }
     for s in &chart.series {
-        let colour = PALETTE[s.colour % PALETTE.len()];
-        let style = colour.stroke_width(2);
+        let (colour, style) = series_style(s);
         let points = s.points.iter().copied();
-        let legend = [(0, 0), (24, 0)];
         if s.dashed {
-            c.draw_series(DashedLineSeries::new(points, 8, 5, style))?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| {
-                    DashedPathElement::new(legend.map(|(dx, dy)| (x + dx, y + dy)), 6, 4, style)
-                });
+            c.draw_series(DashedLineSeries::new(points, 8, 5, style))?;
         } else {
-            c.draw_series(LineSeries::new(points, style))?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(legend.map(|(dx, dy)| (x + dx, y + dy)), style)
-                });
+            c.draw_series(LineSeries::new(points, style))?;
         }
         c.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
     }
-    c.configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(200, 200, 200))
-        .label_font(("sans-serif", 13))
-        .draw()?;
+    Ok(())
+}
+
+/// A series' colour and line style.
+fn series_style(s: &Series) -> (RGBColor, ShapeStyle) {
+    let colour = PALETTE[s.colour % PALETTE.len()];
+    (colour, colour.stroke_width(2))
+}
+
+/// A reference line's style (the `k`-th).
+fn reference_style(k: usize) -> ShapeStyle {
+    PALETTE[6].mix(0.6 - 0.2 * k.min(1) as f64).stroke_width(1)
+}
+
+/// The legend in its own panel beside the plot, so it never hides a point.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    chart: &Chart,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let font = ("sans-serif", 13).into_font().color(&BLACK);
+    let entries = chart
+        .series
+        .iter()
+        .map(|s| (s.label.as_str(), series_style(s).1, s.dashed))
+        .chain(
+            chart
+                .references
+                .iter()
+                .enumerate()
+                .map(|(k, (_, label))| (label.as_str(), reference_style(k), true)),
+        );
+    for (k, (label, style, dashed)) in entries.enumerate() {
+        let y = 60 + 22 * k as i32;
+        let line = [(6, y), (38, y)];
+        if dashed {
+            area.draw(&DashedPathElement::new(line, 6, 4, style))?;
+        } else {
+            area.draw(&PathElement::new(line, style))?;
+        }
+        area.draw(&Text::new(label, (46, y - 7), font.clone()))?;
+    }
     Ok(())
 }
 

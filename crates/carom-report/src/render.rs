@@ -172,12 +172,13 @@ fn scaling_plot(report: &Report, dir: &Path) -> Result<Option<PathBuf>, ReportEr
             parts.push(part);
         }
     }
-    // The broad phase fastest on one thread at each coherent uniform scene's largest size.
+    // carom's broad phase fastest on one thread at each coherent uniform scene's largest
+    // size (the peer runs on one thread only).
     for scene in ["2D uniform0.1 coherent", "3D uniform0.1 coherent"] {
         let best = report
             .broad_phase
             .iter()
-            .filter(|r| r.scene == scene && r.threads == 1)
+            .filter(|r| r.scene == scene && r.threads == 1 && r.method != crate::broad::PEER)
             .max_by(|a, b| a.n.cmp(&b.n).then(b.ns_per_ball.total_cmp(&a.ns_per_ball)));
         if let Some(b) = best {
             parts.push(format!("{} broad phase, {scene}", b.method));
