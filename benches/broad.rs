@@ -31,15 +31,17 @@
 //! parry's BVH (f32, glam) is built with `Bvh::from_leaves(Binned)` one-shot and
 //! updated with `insert_or_update_partially` + `refit` when coherent, then traversed
 //! against itself (`traverse_bvtt_single_tree`); it reports box pairs, unsorted, while
-//! carom's rows include the exact ball test and the sorted output.
+//! carom's rows include the exact ball test and the sorted output. The broad phases and
+//! the peer are built as `carom report` builds them (`carom_report::broad::make_phase`,
+//! `carom_report::peer::parry`).
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use carom::broad::scenes::Scene;
-use carom::broad::{
-    KdTree, Pair, ParallelBroadPhase, SortPolicy, SweepAndPrune, UniformGrid, Volumes,
-};
+use carom::broad::{Pair, ParallelBroadPhase, Volumes};
+use carom_report::broad::{Peer, make_phase};
+use carom_report::peer::parry::{ParryBvh2, ParryBvh3};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
 /// A scene distribution of the benchmark matrix.
@@ -114,18 +116,7 @@ fn sort_spatially<const D: usize>(scene: &mut Scene<f64, D>) {
 }
 
 /// The broad phases measured, by name.
-const PHASES: [&str; 5] = ["sap", "kd", "grid", "hashed", "brute"];
-
-fn make_phase<const D: usize>(name: &str, coherent: bool) -> Box<dyn ParallelBroadPhase<f64, D>> {
-    match name {
-        "sap" if coherent => Box::new(SweepAndPrune::new()),
-        "sap" => Box::new(SweepAndPrune::with_policy(SortPolicy::Radix)),
-        "kd" => Box::new(KdTree::new()),
-        "grid" => Box::new(UniformGrid::dense()),
-        "hashed" => Box::new(UniformGrid::hashed()),
-        _ => Box::new(carom::broad::BruteForce::new()),
-    }
-}
+const PHASES: [&str; 5] = carom_report::broad::METHODS;
 
 /// One frame of a carom broad phase; returns the pair count.
 fn frame<const D: usize>(
@@ -146,59 +137,6 @@ fn frame<const D: usize>(
     }
     out.len()
 }
-
-/// parry's BVH as a peer, in 2D and 3D.
-trait Peer<const D: usize> {
-    /// One frame; returns the pair count.
-    fn frame(&mut self, scene: &Scene<f64, D>, coherent: bool) -> usize;
-}
-
-macro_rules! parry_peer {
-    ($name:ident, $parry:ident, $d:literal) => {
-        #[derive(Default)]
-        struct $name {
-            bvh: Option<$parry::partitioning::Bvh>,
-            workspace: $parry::partitioning::BvhWorkspace,
-            leaves: Vec<$parry::bounding_volume::Aabb>,
-            pairs: Vec<(u32, u32)>,
-        }
-
-        impl Peer<$d> for $name {
-            fn frame(&mut self, scene: &Scene<f64, $d>, coherent: bool) -> usize {
-                use $parry::bounding_volume::Aabb;
-                use $parry::math::Vector;
-                use $parry::partitioning::{Bvh, BvhBuildStrategy};
-                self.leaves.clear();
-                for (c, &r) in scene.centers.iter().zip(&scene.radii) {
-                    let lo: [f32; $d] = core::array::from_fn(|k| (c[k] - r) as f32);
-                    let hi: [f32; $d] = core::array::from_fn(|k| (c[k] + r) as f32);
-                    self.leaves
-                        .push(Aabb::new(Vector::from_array(lo), Vector::from_array(hi)));
-                }
-                match (&mut self.bvh, coherent) {
-                    (Some(bvh), true) => {
-                        for (i, aabb) in self.leaves.iter().enumerate() {
-                            bvh.insert_or_update_partially(*aabb, i as u32, 0.0);
-                        }
-                        bvh.refit(&mut self.workspace);
-                    }
-                    _ => self.bvh = Some(Bvh::from_leaves(BvhBuildStrategy::Binned, &self.leaves)),
-                }
-                self.pairs.clear();
-                let pairs = &mut self.pairs;
-                if let Some(bvh) = &self.bvh {
-                    bvh.traverse_bvtt_single_tree::<false>(&mut self.workspace, &mut |a, b| {
-                        pairs.push((a, b))
-                    });
-                }
-                self.pairs.len()
-            }
-        }
-    };
-}
-
-parry_peer!(Parry2, parry2d, 2);
-parry_peer!(Parry3, parry3d, 3);
 
 fn full() -> bool {
     std::env::var_os("CAROM_BENCH_FULL").is_some()
@@ -346,8 +284,8 @@ fn criterion_benches(c: &mut Criterion) {
         return;
     }
     bench_random_boxes(c);
-    bench_dim::<2>(c, &mut || Box::new(Parry2::default()));
-    bench_dim::<3>(c, &mut || Box::new(Parry3::default()));
+    bench_dim::<2>(c, &mut || Box::new(ParryBvh2::default()));
+    bench_dim::<3>(c, &mut || Box::new(ParryBvh3::default()));
 }
 
 // ---------------------------------------------------------------------------------
@@ -544,8 +482,8 @@ fn print_table() {
             pairs,
         );
     }
-    table_dim::<2>(&mut || Box::new(Parry2::default()));
-    table_dim::<3>(&mut || Box::new(Parry3::default()));
+    table_dim::<2>(&mut || Box::new(ParryBvh2::default()));
+    table_dim::<3>(&mut || Box::new(ParryBvh3::default()));
 }
 
 // ---------------------------------------------------------------------------------

@@ -3,10 +3,12 @@
 //! speed 1 m/s per component), no gravity, `dt = 1/60`, one step per iteration.
 //!
 //! carom runs the semi-implicit Euler integrator and its automatic broad phase (a
-//! uniform grid), in `f64`; rapier2d runs in `f32` with CCD on every ball, restitution 1
-//! (`Max`) and friction 0 (`Min`), and its default integration parameters (see
-//! `crates/carom-sim/tests/common/rapier.rs`, shared with the tests). Both run on a
+//! uniform grid), in `f64`; rapier2d runs in `f32` with CCD on every ball, restitution
+//! exactly 1 and friction 0, and its default integration parameters: the scene is built by
+//! `carom_report::peer::rapier`, the peer of the report and of its tests. Both run on a
 //! rayon pool of 1 and of 2 threads (rapier2d with its `parallel` feature).
+//! `carom report` measures the same scene (section 3) with both engines' steps
+//! interleaved.
 //!
 //! * `cargo bench --bench stepped`: criterion, N = 1e3 and 1e4 (and 1e5 with
 //!   `CAROM_BENCH_FULL=1`), time per step.
@@ -27,10 +29,7 @@ use carom_sim::{BallStates, Simulation, observe};
 use carom_toi::Direction;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
-#[path = "../crates/carom-sim/tests/common/rapier.rs"]
-mod rapier_peer;
-
-use rapier_peer::RapierGas;
+use carom_report::peer::rapier::RapierScene;
 
 const DT: f64 = 1.0 / 60.0;
 
@@ -40,6 +39,11 @@ fn scene(n: usize) -> Scene<f64, 2> {
         ..GasParams::default()
     })
     .expect("a valid gas")
+}
+
+/// rapier2d holding `s`.
+fn rapier_scene(s: &Scene<f64, 2>) -> RapierScene {
+    RapierScene::new(s, DT).expect("rapier2d holds an elastic gas in a box")
 }
 
 /// carom's stepped engine on `s`, stepping one grid step per call.
@@ -114,7 +118,7 @@ fn criterion_benches(c: &mut Criterion) {
             group.bench_function(BenchmarkId::new(format!("carom {threads}t"), n), |b| {
                 b.iter(|| pool.install(|| carom.step()));
             });
-            let mut rapier = RapierGas::new(&s, DT);
+            let mut rapier = rapier_scene(&s);
             group.bench_function(BenchmarkId::new(format!("rapier2d {threads}t"), n), |b| {
                 b.iter(|| pool.install(|| rapier.step()));
             });
@@ -145,12 +149,12 @@ fn drifts(s: &Scene<f64, 2>) -> (f64, f64) {
         carom.step();
     }
     let carom_drift = (carom.energy(s) - e0) / e0;
-    let mut rapier = RapierGas::new(s, DT);
-    let r0 = rapier.energy();
+    let mut rapier = rapier_scene(s);
+    let r0 = rapier.kinetic_energy();
     for _ in 0..300 {
         rapier.step();
     }
-    (carom_drift, (rapier.energy() - r0) / r0)
+    (carom_drift, (rapier.kinetic_energy() - r0) / r0)
 }
 
 fn ms(d: Duration) -> f64 {
@@ -159,7 +163,7 @@ fn ms(d: Duration) -> f64 {
 
 fn print_table() {
     let (one, two) = (pool(1), pool(2));
-    println!("{}", RapierGas::new(&scene(10), DT).settings());
+    println!("{}", rapier_scene(&scene(10)).settings());
     println!(
         "| N | carom 1t (ms/step) | carom 2t | rapier2d 1t | rapier2d 2t | rapier2d / carom (1t) | carom 2t speedup | rapier2d 2t speedup | energy drift 5 s: carom | rapier2d |"
     );
@@ -170,7 +174,7 @@ fn print_table() {
         for (k, p) in [&one, &two].into_iter().enumerate() {
             let mut carom = p.install(|| Carom::new(&s));
             times[k] = p.install(|| median_step(|| carom.step()));
-            let mut rapier = RapierGas::new(&s, DT);
+            let mut rapier = rapier_scene(&s);
             times[2 + k] = p.install(|| median_step(|| rapier.step()));
             black_box(&carom.sim);
         }

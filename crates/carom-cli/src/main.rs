@@ -2,11 +2,15 @@
 //!
 //! * `carom run SCENE.toml --until T [...]` simulates a scene file and prints JSON Lines
 //!   (samples, optional collision events, one summary), following docs/scene-format.md.
+//! * `carom report [--quick | --full] [--out DIR]` measures carom against its peers and
+//!   writes REPORT.md, report.json and plots into DIR (default `carom-report`).
+//! * `carom` alone runs the quick report into `carom-report/` and prints its summary.
 //!
 //! Exit status: 0 on success, 2 on a bad scene or bad flags (one line on stderr naming
 //! the problem), 1 if the simulation itself fails.
 
 mod json;
+mod report;
 mod run;
 
 use std::process::ExitCode;
@@ -17,14 +21,17 @@ use clap::{Parser, Subcommand};
 #[derive(Parser, Debug)]
 #[command(name = "carom", version, about, long_about = None)]
 struct Cli {
+    /// With no command: the quick report into `carom-report/`.
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
 }
 
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Simulate a scene file and print JSON Lines.
     Run(run::RunArgs),
+    /// Measure carom against its peers: REPORT.md, report.json and plots.
+    Report(report::ReportArgs),
 }
 
 fn main() -> ExitCode {
@@ -41,7 +48,9 @@ fn main() -> ExitCode {
         }
     };
     match cli.command {
-        Command::Run(args) => run::main(&args),
+        Some(Command::Run(args)) => run::main(&args),
+        Some(Command::Report(args)) => report::main(&args),
+        None => report::main(&report::ReportArgs::quick_default()),
     }
 }
 

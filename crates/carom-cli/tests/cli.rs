@@ -291,3 +291,33 @@ mass = 2.0
         assert!((d - 0.25).abs() < 1e-9, "{d}");
     }
 }
+
+/// The stderr of a run that must fail with status 2 (bad flags).
+fn rejected(args: &[&str]) -> String {
+    let out = carom(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    assert!(out.stdout.is_empty(), "{args:?}");
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.lines().count(), 1, "one line: {err}");
+    err
+}
+
+#[test]
+fn report_options_are_checked_before_anything_runs() {
+    assert!(rejected(&["report", "--fast"]).contains("--fast"));
+    let both = rejected(&["report", "--quick", "--full"]);
+    assert!(
+        both.contains("--quick") && both.contains("--full"),
+        "{both}"
+    );
+    assert!(rejected(&["report", "--out"]).contains("--out"));
+    assert!(rejected(&["report", "extra"]).contains("extra"));
+    // --help lists the options and runs nothing.
+    let help = carom(&["report", "--help"]);
+    assert!(help.status.success());
+    let text = String::from_utf8(help.stdout).unwrap();
+    for flag in ["--quick", "--full", "--out"] {
+        assert!(text.contains(flag), "{flag}: {text}");
+    }
+    assert!(text.contains("carom-report"), "the default folder: {text}");
+}

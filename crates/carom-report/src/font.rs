@@ -1,6 +1,7 @@
 //! The font of the report's plots. plotters lays out text with ab_glyph (the workspace
-//! enables that feature for the examples' bitmaps), which has no system fonts: the
-//! examples' DejaVu Sans is embedded and registered as `sans-serif` once per process.
+//! enables that feature for the examples' bitmaps), which has no system fonts: DejaVu
+//! Sans (the crate's own copy in `assets/`, with its licence, so the crate packages on
+//! its own) is embedded and registered as `sans-serif` once per process.
 
 use std::sync::Once;
 
@@ -9,7 +10,7 @@ use plotters::style::FontStyle;
 /// The family name plots use.
 pub const FAMILY: &str = "sans-serif";
 
-static DEJAVU_SANS: &[u8] = include_bytes!("../../../examples/assets/DejaVuSans.ttf");
+static DEJAVU_SANS: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// Registers the embedded font with plotters (idempotent).
 pub fn register() {

@@ -52,6 +52,10 @@ pub struct Machine {
     pub optimized: bool,
     /// When the report was run, seconds since the Unix epoch.
     pub unix_time: u64,
+    /// The system's 1-minute load average when the report started (Linux), a measure of
+    /// the other work competing for the CPUs.
+    #[serde(default)]
+    pub load_average: Option<f64>,
 }
 
 /// One engine on one scene at one size and thread count.
