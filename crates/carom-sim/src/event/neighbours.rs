@@ -366,9 +366,9 @@ mod tests {
     ) -> (Vec<Vector<f64, D>>, Vec<f64>) {
         let mut g = SplitMix64::new(seed);
         let p = (0..n)
-            .map(|_| Vector::<f64, D>::from_fn(|_, _| side * g.uniform()))
+            .map(|_| Vector::<f64, D>::from_fn(|_, _| side * g.next_f64()))
             .collect();
-        let r = (0..n).map(|_| 0.05 + 0.2 * g.uniform()).collect();
+        let r = (0..n).map(|_| 0.05 + 0.2 * g.next_f64()).collect();
         (p, r)
     }
 
@@ -388,7 +388,7 @@ mod tests {
             let mut g = SplitMix64::new(seed + 100);
             for _ in 0..500 {
                 let i = (g.next_u64() % 300) as usize;
-                let p = Vector3::from_fn(|_, _| side * g.uniform());
+                let p = Vector3::from_fn(|_, _| side * g.next_f64());
                 l.rebuild(i, p);
             }
             assert_eq!(
@@ -406,7 +406,7 @@ mod tests {
         let (mut pos, rad) = random_points::<2>(200, 1.0, 5);
         let mut g = SplitMix64::new(6);
         for p in &mut pos {
-            *p = Vector2::new(6.0 * g.uniform(), 2.3 * g.uniform());
+            *p = Vector2::new(6.0 * g.next_f64(), 2.3 * g.next_f64());
         }
         let rad: Vec<f64> = rad.iter().map(|r| r.min(0.25)).collect();
         let l = NeighbourLists::new(

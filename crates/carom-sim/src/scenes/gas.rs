@@ -124,7 +124,7 @@ pub fn gas<const D: usize>(p: &GasParams) -> Result<Scene<f64, D>, SceneError> {
             let pos = Vector::<f64, D>::from_fn(|_, _| {
                 let k = rest % per_side;
                 rest /= per_side;
-                -half + (k as f64 + 0.5) * spacing + slack * (2.0 * rng.uniform() - 1.0)
+                -half + (k as f64 + 0.5) * spacing + slack * (2.0 * rng.next_f64() - 1.0)
             });
             let vel = Vector::<f64, D>::from_fn(|_, _| rng.normal());
             BallSpec::new(pos, vel, p.radius, p.mass)

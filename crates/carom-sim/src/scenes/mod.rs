@@ -11,39 +11,10 @@ pub mod classic;
 pub mod collision_lab;
 pub mod gas;
 
-/// A small deterministic random generator (SplitMix64, Steele, Lea and Flood 2014):
-/// scenes built from a seed are identical on every machine and in every version,
+/// The deterministic random generator of every shared scene: carom-broad's SplitMix64,
+/// so scenes built from a seed are identical on every machine and in every version,
 /// which a dependency's generator does not promise.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// A generator from `seed`.
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)` with 53 random bits.
-    pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    /// A standard normal deviate (Box–Muller).
-    pub fn normal(&mut self) -> f64 {
-        let u = 1.0 - self.uniform(); // (0, 1]: the log is finite
-        let v = self.uniform();
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
+pub use carom_broad::scenes::SplitMix64;
 
 #[cfg(test)]
 mod tests {
@@ -64,7 +35,7 @@ mod tests {
         let n = 200_000;
         let (mut s, mut s2, mut z2) = (0.0, 0.0, 0.0);
         for _ in 0..n {
-            let u = g.uniform();
+            let u = g.next_f64();
             assert!((0.0..1.0).contains(&u));
             s += u;
             s2 += u * u;
