@@ -34,6 +34,28 @@ fn xy(v: &Vector2<f64>) -> (f64, f64) {
     (v.x, v.y)
 }
 
+/// A ball–ball contact: a diamond at `p` with its number (as in the collision table)
+/// `rise` pixels above and to the right.
+fn contact_marker(canvas: &Canvas<'_>, p: Px, number: usize, rise: f64) -> Drawn {
+    let s = 5.0;
+    canvas.polygon(
+        &[
+            (p.0, p.1 - s),
+            (p.0 + s, p.1),
+            (p.0, p.1 + s),
+            (p.0 - s, p.1),
+        ],
+        INK.to_rgba(),
+    )?;
+    canvas.text(
+        &format!("{number}"),
+        (p.0 + 7.0, p.1 - rise),
+        12.0,
+        INK,
+        Anchor::Left,
+    )
+}
+
 /// What a play-area picture shows.
 #[derive(Clone, Copy)]
 struct Layers {
@@ -313,24 +335,7 @@ fn markers(canvas: &Canvas<'_>, record: &Record, l: &Layout, t: f64) -> Drawn {
                     let (pi, pj) = (instant.after.pos[i], instant.after.pos[j]);
                     let (ri, rj) = (scene.balls[i].radius, scene.balls[j].radius);
                     let contact = pi + (pj - pi) * (ri / (ri + rj));
-                    let p = v.px(xy(&contact));
-                    let s = 5.0;
-                    canvas.polygon(
-                        &[
-                            (p.0, p.1 - s),
-                            (p.0 + s, p.1),
-                            (p.0, p.1 + s),
-                            (p.0 - s, p.1),
-                        ],
-                        INK.to_rgba(),
-                    )?;
-                    canvas.text(
-                        &format!("{}", n + 1),
-                        (p.0 + 7.0, p.1 - 9.0),
-                        12.0,
-                        INK,
-                        Anchor::Left,
-                    )?;
+                    contact_marker(canvas, v.px(xy(&contact)), n + 1, 9.0)?;
                 }
             }
         }
@@ -480,23 +485,7 @@ fn spacetime(
                 let (xi, xj) = (instant.after.pos[i].x, instant.after.pos[j].x);
                 let (ri, rj) = (scene.balls[i].radius, scene.balls[j].radius);
                 let p = (x_of(xi + (xj - xi) * (ri / (ri + rj))), y_of(instant.t));
-                let s = 5.0;
-                canvas.polygon(
-                    &[
-                        (p.0, p.1 - s),
-                        (p.0 + s, p.1),
-                        (p.0, p.1 + s),
-                        (p.0 - s, p.1),
-                    ],
-                    INK.to_rgba(),
-                )?;
-                canvas.text(
-                    &format!("{}", n + 1),
-                    (p.0 + 7.0, p.1 - 8.0),
-                    12.0,
-                    INK,
-                    Anchor::Left,
-                )?;
+                contact_marker(canvas, p, n + 1, 8.0)?;
             }
         }
     }

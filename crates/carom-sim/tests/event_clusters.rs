@@ -63,11 +63,7 @@ fn states(sim: &EventEngine<f64, 2>) -> BallStates<f64, 2> {
 
 #[test]
 fn every_inelastic_preset_sticks_keeping_momentum_and_angular_momentum() {
-    for preset in [
-        InelasticPreset::HeadOn,
-        InelasticPreset::CrissCross,
-        InelasticPreset::Glancing,
-    ] {
+    for preset in InelasticPreset::ALL {
         let s = stick(preset, false);
         let mut sim = EventEngine::new(&s, &plan(), Direction::Forward).unwrap();
         let (p0, l0, e0) = invariants(&s, &states(&sim));

@@ -576,16 +576,8 @@ fn three_dimensional_scenes_with_walls_and_boxes_run() {
 #[test]
 fn every_collision_lab_screen_runs_and_keeps_what_the_sim_teaches() {
     use carom_sim::scene::Inelastic;
-    use carom_sim::scenes::collision_lab::{InelasticPreset, Options, Screen, scene};
-    let screens = [
-        Screen::Intro,
-        Screen::Explore1d,
-        Screen::Explore2d,
-        Screen::Inelastic(InelasticPreset::HeadOn),
-        Screen::Inelastic(InelasticPreset::CrissCross),
-        Screen::Inelastic(InelasticPreset::Glancing),
-    ];
-    for screen in screens {
+    use carom_sim::scenes::collision_lab::{Options, Screen, scene};
+    for screen in Screen::ALL {
         for elasticity in [None, Some(100.0), Some(50.0), Some(0.0)] {
             for inelastic in [Inelastic::Slide, Inelastic::Stick] {
                 for reflecting_border in [true, false] {

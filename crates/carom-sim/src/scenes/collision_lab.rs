@@ -42,6 +42,23 @@ pub enum InelasticPreset {
     Glancing,
 }
 
+impl InelasticPreset {
+    /// Every preset, in the sim's order.
+    pub const ALL: [Self; 3] = [Self::HeadOn, Self::CrissCross, Self::Glancing];
+}
+
+impl Screen {
+    /// Every screen, each Inelastic preset as its own, in the sim's order.
+    pub const ALL: [Self; 6] = [
+        Self::Intro,
+        Self::Explore1d,
+        Self::Explore2d,
+        Self::Inelastic(InelasticPreset::HeadOn),
+        Self::Inelastic(InelasticPreset::CrissCross),
+        Self::Inelastic(InelasticPreset::Glancing),
+    ];
+}
+
 /// The options of the simulation's control panel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
@@ -196,15 +213,7 @@ mod tests {
 
     #[test]
     fn every_screen_and_option_gives_a_valid_scene() {
-        let screens = [
-            Screen::Intro,
-            Screen::Explore1d,
-            Screen::Explore2d,
-            Screen::Inelastic(InelasticPreset::HeadOn),
-            Screen::Inelastic(InelasticPreset::CrissCross),
-            Screen::Inelastic(InelasticPreset::Glancing),
-        ];
-        for screen in screens {
+        for screen in Screen::ALL {
             for constant_size in [false, true] {
                 for reflecting_border in [false, true] {
                     let opts = Options {
