@@ -66,6 +66,10 @@ use self::obstacles::BoxArrays;
 use self::response::{Contacts, Effect, RestSets, Rules, Surface};
 use self::rest::{Support, Touch};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
+
+/// Escapees per parallel task of the step's first predictions (each is a broad-phase
+/// query and a few times of impact, about a microsecond).
+const ESCAPEE_CHUNK: usize = 32;
 use crate::engine::{BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation};
 use crate::plan::{DEFAULT_DT, Plan, can_stick, stepped_broad_phase};
 use crate::scene::{Scene, SceneError};
@@ -139,6 +143,8 @@ where
     chunk_events: Vec<Vec<Event<T, D>>>,
     chunk_status: Vec<Result<(), Overflow>>,
     candidates: Vec<u32>,
+    /// Events of one ball's prediction (scratch).
+    found: Vec<Event<T, D>>,
     touches: [Vec<Touch<T, D>>; 2],
     clock: Clock<T>,
     counters: Counters,
@@ -237,6 +243,7 @@ where
             chunk_events: Vec::new(),
             chunk_status: Vec::new(),
             candidates: Vec::new(),
+            found: Vec::new(),
             touches: [Vec::new(), Vec::new()],
             clock: Clock {
                 dt,
@@ -443,13 +450,16 @@ where
         }
     }
 
-    /// Predicts every contact of the window `[a, b]` from the broad phase's pairs.
+    /// Predicts every contact of the window `[a, b]`: the broad phase's pairs, each ball
+    /// against the walls, and the escapees by query.
     fn predict_all(&mut self, a: T, b: T, parallel: bool) -> Result<(), Overflow> {
         let n = self.balls.len();
         let pairs = &self.sweep.pairs;
+        let escapees = self.sweep.escapees();
         let pair_chunks = pairs.len().div_ceil(CHUNK);
         let ball_chunks = n.div_ceil(CHUNK);
-        let chunks = pair_chunks + ball_chunks;
+        let escapee_chunks = escapees.len().div_ceil(ESCAPEE_CHUNK);
+        let chunks = pair_chunks + ball_chunks + escapee_chunks;
         if self.chunk_events.len() < chunks {
             self.chunk_events.resize_with(chunks, Vec::new);
         }
@@ -464,7 +474,8 @@ where
             instant: T::lit(self.clock.dt * 1e-6),
         };
         let periodic_boxes = self.periodic.is_some() && self.boxes.len() > 0;
-        let entries = self.sweep.entries();
+        let sweep = &self.sweep;
+        let entries = sweep.entries();
         let nboxes = self.boxes.len();
         let work = |c: usize, out: &mut Vec<Event<T, D>>| -> Result<(), Overflow> {
             out.clear();
@@ -484,6 +495,17 @@ where
                         push(narrow.ball_box(i, j - n, a))?;
                     }
                 }
+            } else if c >= pair_chunks + ball_chunks {
+                // An escapee's path left its entry: its candidates come from a query.
+                let first = (c - pair_chunks - ball_chunks) * ESCAPEE_CHUNK;
+                let last = (first + ESCAPEE_CHUNK).min(escapees.len());
+                let mut candidates = Vec::new();
+                let mut result = Ok(());
+                for &e in &escapees[first..last] {
+                    let r = narrow.ball_events(sweep, e as usize, a, &[], &mut candidates, out);
+                    result = result.and(r);
+                }
+                result?;
             } else {
                 let first = (c - pair_chunks) * CHUNK;
                 let last = (first + CHUNK).min(n);
@@ -511,6 +533,9 @@ where
             buffers
                 .par_iter_mut()
                 .zip(status.par_iter_mut())
+                // One chunk per task: pair chunks cost far more than ball chunks, and
+                // rayon's default split hands each thread a few long runs.
+                .with_max_len(1)
                 .enumerate()
                 .for_each(|(c, (out, status))| *status = work(c, out));
         } else {
@@ -532,50 +557,15 @@ where
     /// Predicts the contacts of ball `i` after `s` within the window ending at `end`,
     /// skipping partners in `skip` (already predicted against `i`).
     fn predict_ball(&mut self, i: usize, s: T, end: T, skip: &[u32]) -> Result<(), Overflow> {
-        let n = self.balls.len();
-        let x = self.balls.position_at(i, s);
-        let path = path_box(&x, &self.balls.pos[i], self.balls.radius[i]);
         let mut candidates = core::mem::take(&mut self.candidates);
-        self.sweep.candidates(&path, &mut candidates);
-        candidates.sort_unstable();
-        candidates.dedup();
-        let narrow = self.narrow(end);
-        let mut found = Vec::new();
-        let mut result = Ok(());
-        for &c in &candidates {
-            let c = c as usize;
-            let p = if c < n {
-                if c == i || skip.contains(&(c as u32)) {
-                    continue;
-                }
-                narrow.ball_ball(i.min(c), i.max(c), s)
-            } else if self.sweep.boxes_inside() {
-                narrow.ball_box(i, c - n, s)
-            } else {
-                continue;
-            };
-            match p {
-                Ok(Some(e)) => found.push(e),
-                Ok(None) => {}
-                Err(e) => result = result.and(Err(e)),
-            }
-        }
-        if self.periodic.is_some() {
-            for k in 0..self.boxes.len() {
-                match narrow.ball_box(i, k, s) {
-                    Ok(Some(e)) => found.push(e),
-                    Ok(None) => {}
-                    Err(e) => result = result.and(Err(e)),
-                }
-            }
-        }
-        match narrow.ball_border(i, s) {
-            Ok(Some(e)) => found.push(e),
-            Ok(None) => {}
-            Err(e) => result = result.and(Err(e)),
-        }
-        self.queue.extend(found.into_iter().map(Pending));
+        let mut found = core::mem::take(&mut self.found);
+        found.clear();
+        let result =
+            self.narrow(end)
+                .ball_events(&self.sweep, i, s, skip, &mut candidates, &mut found);
+        self.queue.extend(found.iter().map(|&e| Pending(e)));
         self.candidates = candidates;
+        self.found = found;
         result
     }
 
@@ -714,7 +704,7 @@ where
         let n = b.len();
         let path = path_box(&x, &b.pos[i], r + tolerance);
         let mut candidates = core::mem::take(&mut self.candidates);
-        self.sweep.candidates(&path, &mut candidates);
+        self.sweep.candidates(i, &path, &mut candidates);
         let g = self.rules.gravity;
         let boxes = if self.sweep.boxes_inside() {
             None
@@ -895,17 +885,10 @@ where
         while a < h {
             let b = self.window_end(a, h);
             if first {
-                let escapees = self
-                    .sweep
-                    .begin_step(&self.balls, &self.boxes, h, self.escape_bound, parallel)
-                    .len();
+                self.sweep
+                    .begin_step(&self.balls, &self.boxes, h, self.escape_bound, parallel);
                 self.predict_all(a, b, parallel)
                     .map_err(|o| self.overflow(o, t0 + a))?;
-                for k in 0..escapees {
-                    let e = self.sweep.escapee(k);
-                    self.predict_ball(e, a, b, &[])
-                        .map_err(|o| self.overflow(o, t0 + a))?;
-                }
             } else {
                 let reach = if self.periodic.is_some() {
                     b - a

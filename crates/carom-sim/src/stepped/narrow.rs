@@ -35,7 +35,7 @@ use nalgebra::Const;
 use super::balls::BallArrays;
 use super::clusters::FREE;
 use super::obstacles::{BoxArrays, image_offsets};
-use super::sweep::{overlap, path_box};
+use super::sweep::{Sweep, overlap, path_box};
 
 /// What a ball touches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -227,6 +227,53 @@ where
             [b.version[i], b.version[j]],
             shift,
         )
+    }
+
+    /// Appends to `found` the contacts of ball `i` after `s` within the window: the
+    /// balls and boxes of `sweep`'s candidates for its remaining path (skipping balls in
+    /// `skip`, already predicted against `i`), every box in a periodic domain, and the
+    /// walls. `candidates` is scratch.
+    ///
+    /// # Errors
+    /// The first overflowing prediction (the others are still appended).
+    pub(crate) fn ball_events(
+        &self,
+        sweep: &Sweep<T, D>,
+        i: usize,
+        s: T,
+        skip: &[u32],
+        candidates: &mut Vec<u32>,
+        found: &mut Vec<Event<T, D>>,
+    ) -> Result<(), Overflow> {
+        let n = self.balls.len();
+        let x = self.balls.position_at(i, s);
+        let path = path_box(&x, &self.balls.pos[i], self.balls.radius[i]);
+        sweep.candidates(i, &path, candidates);
+        candidates.sort_unstable();
+        candidates.dedup();
+        let mut result = Ok(());
+        let mut push = |p: Prediction<T, D>| match p {
+            Ok(Some(e)) => found.push(e),
+            Ok(None) => {}
+            Err(e) => result = result.and(Err(e)),
+        };
+        for &c in candidates.iter() {
+            let c = c as usize;
+            if c < n {
+                if c != i && !skip.contains(&(c as u32)) {
+                    push(self.ball_ball(i.min(c), i.max(c), s));
+                }
+            } else if sweep.boxes_inside() {
+                push(self.ball_box(i, c - n, s));
+            }
+        }
+        if self.periodic.is_some() {
+            for k in 0..self.boxes.len() {
+                push(self.ball_box(i, k, s));
+            }
+        }
+        push(self.ball_border(i, s));
+        result
     }
 
     /// The first wall of the reflecting border ball `i` touches after `s`.

@@ -20,8 +20,11 @@
 //! step after a collision (it was hit by a faster ball), is an **escapee**: its path box is
 //! kept in a short list, and every prediction for it queries the broad phase and scans the
 //! list. The invariant that makes this exact: every ball's remaining path lies in its
-//! entry or, for an escapee, in its listed box; a prediction queries the broad phase with
-//! the ball's path box and scans the escapees, so no pair that can touch is missed. When
+//! entry or, for an escapee, in its listed box. A prediction for a ball that has not
+//! escaped reads its **partner list** (the pairs, turned into per-ball lists at each
+//! build): a ball that can touch its path has its own path in its entry, which then meets
+//! this ball's entry, or is an escapee; a prediction for an escapee queries the broad
+//! phase with its path box. Both scan the escapees, so no pair that can touch is missed. When
 //! the list grows past a bound (a sixteenth of the balls, at least 64), the broad phase is
 //! rebuilt: at the start of a step, or mid-step by ending the window at the current time
 //! (bounded work; see `StepStats::windows` and `StepStats::rebuilds`).
@@ -44,7 +47,7 @@ pub(crate) const MAX_REACH_STEPS: usize = 16;
 
 /// The broad phase and its buffers.
 pub(crate) struct Sweep<T: Real, const D: usize> {
-    phase: Box<dyn ParallelBroadPhase<T, D>>,
+    phase: Box<dyn ParallelBroadPhase<T, D> + Sync>,
     choice: BroadChoice,
     /// Boxes take part (open space); in a periodic domain they are tested separately.
     boxes_inside: bool,
@@ -55,8 +58,9 @@ pub(crate) struct Sweep<T: Real, const D: usize> {
     /// Per ball: the box its centre must stay in for its path to fit its entry (the
     /// entry shrunk by the radius and a rounding allowance).
     cores: Vec<Aabb<T, D>>,
-    /// Whether each ball's path fits its entry at the start of a step (scratch).
-    fits: Vec<bool>,
+    /// Per chunk of balls: those whose paths leave their entries at the start of a step
+    /// (scratch).
+    misfits: Vec<Vec<u32>>,
     /// Per-chunk sums (scratch).
     sums: Vec<T>,
     /// Builds so far.
@@ -65,13 +69,20 @@ pub(crate) struct Sweep<T: Real, const D: usize> {
     volumes: Vec<Aabb<T, D>>,
     /// This window's overlapping pairs.
     pub(crate) pairs: Vec<(u32, u32)>,
-    /// Query results.
-    hits: Vec<u32>,
-    /// The escapees, in the order they escaped.
+    /// The pairs as adjacency lists: ball `i`'s partners (balls, and boxes as `n + k`)
+    /// are `partners[partner_start[i]..partner_start[i + 1]]`.
+    partner_start: Vec<usize>,
+    partners: Vec<u32>,
+    /// The escapees, in the order they escaped, and their boxes (kept side by side so
+    /// that a scan reads one contiguous array).
     escaped: Vec<u32>,
-    /// Per ball: its escapee box, if it escaped.
-    escape_box: Vec<Option<Aabb<T, D>>>,
+    escape_boxes: Vec<Aabb<T, D>>,
+    /// Per ball: its index in `escaped`, or [`NOT_ESCAPED`].
+    escape_slot: Vec<u32>,
 }
+
+/// The `escape_slot` of a ball that has not escaped.
+const NOT_ESCAPED: u32 = u32::MAX;
 
 impl<T: Real, const D: usize> Sweep<T, D>
 where
@@ -80,7 +91,7 @@ where
     /// A broad phase of kind `choice` (already resolved, never `Auto`) for `n` balls, in
     /// the periodic domain `periodic` if given.
     pub(crate) fn new(choice: BroadChoice, n: usize, periodic: Option<&Border<T, D>>) -> Self {
-        let phase: Box<dyn ParallelBroadPhase<T, D>> = match (choice, periodic) {
+        let phase: Box<dyn ParallelBroadPhase<T, D> + Sync> = match (choice, periodic) {
             (BroadChoice::Brute | BroadChoice::Auto, None) => Box::new(BruteForce::new()),
             (BroadChoice::Brute | BroadChoice::Auto, Some(b)) => Box::new(BruteForce::periodic(b)),
             (BroadChoice::Sap, _) => Box::new(SweepAndPrune::new()),
@@ -95,14 +106,16 @@ where
             built: false,
             balls: n,
             cores: Vec::with_capacity(n),
-            fits: Vec::with_capacity(n),
+            misfits: Vec::new(),
             sums: Vec::new(),
             builds: 0,
             volumes: Vec::with_capacity(n),
             pairs: Vec::new(),
-            hits: Vec::new(),
+            partner_start: Vec::with_capacity(n + 1),
+            partners: Vec::new(),
             escaped: Vec::new(),
-            escape_box: vec![None; n],
+            escape_boxes: Vec::new(),
+            escape_slot: vec![NOT_ESCAPED; n],
         }
     }
 
@@ -123,8 +136,8 @@ where
 
     /// Makes the broad phase valid for a step of length `h` whose paths start at in-step
     /// time 0: keeps the entries if every ball's path and every box's sweep still fits
-    /// (balls that do not fit become escapees, up to the bound), rebuilds them otherwise.
-    /// Returns the escapees the caller must predict by query (empty after a rebuild).
+    /// (balls that do not fit become escapees, up to the bound, to be predicted by
+    /// query), rebuilds them otherwise (no escapees).
     pub(crate) fn begin_step(
         &mut self,
         balls: &BallArrays<T, D>,
@@ -132,34 +145,48 @@ where
         h: T,
         escape_bound: usize,
         parallel: bool,
-    ) -> &[u32] {
+    ) {
         self.clear_escapees();
         if self.built && self.boxes_fit(boxes, h) {
             let n = balls.len();
-            self.fits.resize(n, true);
+            let chunks = n.div_ceil(CHUNK);
+            let mut misfits = core::mem::take(&mut self.misfits);
+            misfits.resize_with(chunks, Vec::new);
             let cores = &self.cores;
-            fill(&mut self.fits, parallel, |i| {
-                let core = &cores[i];
-                [balls.seg_x[i], balls.pos[i]]
-                    .iter()
-                    .all(|p| (0..D).all(|k| core.min()[k] <= p[k] && p[k] <= core.max()[k]))
-            });
-            for (i, _) in self.fits.iter().enumerate().filter(|(_, fits)| !**fits) {
-                if self.escaped.len() >= escape_bound {
-                    break;
+            let collect = |c: usize, out: &mut Vec<u32>| {
+                out.clear();
+                let first = c * CHUNK;
+                for (i, core) in (first..).zip(&cores[first..(first + CHUNK).min(n)]) {
+                    let fits = [balls.seg_x[i], balls.pos[i]]
+                        .iter()
+                        .all(|p| (0..D).all(|k| core.min()[k] <= p[k] && p[k] <= core.max()[k]));
+                    if !fits {
+                        out.push(i as u32);
+                    }
                 }
-                self.escaped.push(i as u32);
-                self.escape_box[i] =
-                    Some(path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]));
+            };
+            if parallel {
+                misfits[..chunks]
+                    .par_iter_mut()
+                    .enumerate()
+                    .for_each(|(c, out)| collect(c, out));
+            } else {
+                for (c, out) in misfits[..chunks].iter_mut().enumerate() {
+                    collect(c, out);
+                }
             }
+            for &i in misfits[..chunks].iter().flatten().take(escape_bound) {
+                let i = i as usize;
+                self.escape(i, path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]));
+            }
+            self.misfits = misfits;
             if self.escaped.len() < escape_bound {
-                return &self.escaped;
+                return;
             }
             self.clear_escapees();
         }
         let steps = self.reach_steps(balls, h, parallel);
         self.build(balls, boxes, T::zero(), h * T::from_count(steps), parallel);
-        &self.escaped
     }
 
     /// How many steps `K` a reach box should hold: the mean ball travels half the mean
@@ -184,9 +211,18 @@ where
 
     fn clear_escapees(&mut self) {
         for &e in &self.escaped {
-            self.escape_box[e as usize] = None;
+            self.escape_slot[e as usize] = NOT_ESCAPED;
         }
         self.escaped.clear();
+        self.escape_boxes.clear();
+    }
+
+    /// Lists ball `i` (not an escapee yet) as an escapee with box `path`.
+    fn escape(&mut self, i: usize, path: Aabb<T, D>) {
+        // The escapees are fewer than the balls, whose count fits in u32.
+        self.escape_slot[i] = self.escaped.len() as u32;
+        self.escaped.push(i as u32);
+        self.escape_boxes.push(path);
     }
 
     /// Rebuilds from the balls' paths at in-step time `a`, each ball reaching as far as
@@ -236,6 +272,7 @@ where
             self.phase.update(volumes);
             self.phase.pairs(&mut self.pairs);
         }
+        self.link_partners();
         self.built = self.boxes_inside;
         self.builds += 1;
     }
@@ -245,12 +282,49 @@ where
         self.builds
     }
 
+    /// Turns the pair list into per-ball partner lists (a counting sort: both balls of a
+    /// pair list each other; a ball lists a box, never the reverse).
+    fn link_partners(&mut self) {
+        let n = self.balls;
+        self.partner_start.clear();
+        self.partner_start.resize(n + 1, 0);
+        for &(i, j) in &self.pairs {
+            self.partner_start[i as usize + 1] += 1;
+            if (j as usize) < n {
+                self.partner_start[j as usize + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            self.partner_start[i + 1] += self.partner_start[i];
+        }
+        self.partners.resize(self.partner_start[n], 0);
+        // `next[i]` runs from `partner_start[i]` up as ball i's list fills.
+        let mut next = core::mem::take(&mut self.partner_start);
+        for &(i, j) in &self.pairs {
+            self.partners[next[i as usize]] = j;
+            next[i as usize] += 1;
+            if (j as usize) < n {
+                self.partners[next[j as usize]] = i;
+                next[j as usize] += 1;
+            }
+        }
+        // Each `next[i]` ended at ball i's end, which is ball i + 1's start.
+        next.rotate_right(1);
+        next[0] = 0;
+        self.partner_start = next;
+    }
+
     /// Whether `path` (a ball's remaining path box) lies in ball `i`'s entry.
     fn holds(&self, i: usize, path: &Aabb<T, D>) -> bool {
-        contains(
-            self.escape_box[i].as_ref().unwrap_or(&self.volumes[i]),
-            path,
-        )
+        contains(self.box_of(i), path)
+    }
+
+    /// Ball `i`'s escapee box if it escaped, its entry otherwise.
+    fn box_of(&self, i: usize) -> &Aabb<T, D> {
+        match self.escape_slot[i] {
+            NOT_ESCAPED => &self.volumes[i],
+            slot => &self.escape_boxes[slot as usize],
+        }
     }
 
     /// Records that ball `i`'s remaining path now has the box `path`: if it leaves the
@@ -258,10 +332,10 @@ where
     /// number of escapees.
     pub(crate) fn moved(&mut self, i: usize, path: Aabb<T, D>) -> usize {
         if !self.holds(i, &path) {
-            if self.escape_box[i].is_none() {
-                self.escaped.push(i as u32);
+            match self.escape_slot[i] {
+                NOT_ESCAPED => self.escape(i, path),
+                slot => self.escape_boxes[slot as usize] = path,
             }
-            self.escape_box[i] = Some(path);
         }
         self.escaped.len()
     }
@@ -271,22 +345,28 @@ where
         &self.volumes
     }
 
-    /// The `k`-th escapee.
-    pub(crate) fn escapee(&self, k: usize) -> usize {
-        self.escaped[k] as usize
+    /// The escapees, in the order they escaped.
+    pub(crate) fn escapees(&self) -> &[u32] {
+        &self.escaped
     }
 
-    /// The candidates a ball whose remaining path box is `path` can meet: indices of
-    /// balls (`< n`) and boxes (`n + k`, open space only) from the broad phase, then the
-    /// escapees whose boxes overlap `path`, into `out` (cleared first; may repeat).
-    pub(crate) fn candidates(&mut self, path: &Aabb<T, D>, out: &mut Vec<u32>) {
-        self.phase.query_aabb(path, &mut self.hits);
-        out.clear();
-        out.extend_from_slice(&self.hits);
-        for &e in &self.escaped {
-            if let Some(b) = &self.escape_box[e as usize]
-                && overlap(b, path)
-            {
+    /// The candidates ball `i`, whose remaining path (or a box around it) is `path`, can
+    /// meet: indices of balls (`< n`, possibly `i` itself) and boxes (`n + k`, open space
+    /// only), then the escapees whose boxes overlap `path`, into `out` (cleared first;
+    /// may repeat).
+    ///
+    /// If `path` lies in ball `i`'s entry, the candidates are its partners: a ball that
+    /// can touch `path` keeps its own path in its entry (or is an escapee), so its entry
+    /// meets `i`'s and the two are a pair. Otherwise the broad phase is queried.
+    pub(crate) fn candidates(&self, i: usize, path: &Aabb<T, D>, out: &mut Vec<u32>) {
+        if self.escape_slot[i] == NOT_ESCAPED && contains(&self.volumes[i], path) {
+            out.clear();
+            out.extend_from_slice(&self.partners[self.partner_start[i]..self.partner_start[i + 1]]);
+        } else {
+            self.phase.query_aabb(path, out);
+        }
+        for (&e, b) in self.escaped.iter().zip(&self.escape_boxes) {
+            if overlap(b, path) {
                 out.push(e);
             }
         }
@@ -366,4 +446,120 @@ pub(crate) fn path_box<T: Real, const D: usize>(
     let half = r + pad(from, r).max(pad(to, r));
     let h = Vector::<T, D>::repeat(half);
     Aabb::new_unchecked(from.inf(to) - h, from.sup(to) + h)
+}
+
+#[cfg(test)]
+mod tests {
+    use carom_geometry::Obb;
+    use carom_math::Vector;
+
+    use super::*;
+    use crate::scene::BoxSpec;
+    use crate::scenes::gas::{GasParams, gas};
+
+    /// A dense gas with two boxes, its arrays, and a grid built over `reach`.
+    fn built(reach: f64) -> (BallArrays<f64, 2>, Sweep<f64, 2>) {
+        let mut scene = gas::<2>(&GasParams {
+            n: 2000,
+            fraction: 0.3,
+            speed: 3.0,
+            ..GasParams::default()
+        })
+        .unwrap();
+        for (x, angle) in [(-5.0, 0.3), (6.0, 0.0)] {
+            scene.boxes.push(BoxSpec {
+                shape: Obb::from_angle(Vector::from([x, 1.0]), Vector::from([0.2, 3.0]), angle)
+                    .unwrap(),
+                vel: Vector::from([0.5, 0.0]),
+                restitution: 1.0,
+            });
+        }
+        let mut balls = BallArrays::from_scene(&scene, 1.0).unwrap();
+        for i in 0..balls.len() {
+            balls.seg_x[i] = balls.pos[i];
+            balls.chord[i] = balls.vel[i];
+        }
+        let boxes = BoxArrays::new(&scene.boxes, 1.0);
+        let mut sweep = Sweep::new(BroadChoice::Grid, balls.len(), None);
+        sweep.build(&balls, &boxes, 0.0, reach, false);
+        (balls, sweep)
+    }
+
+    /// The volumes whose entries meet `query`, by brute force (ball `i` left out).
+    fn brute(sweep: &Sweep<f64, 2>, i: usize, query: &Aabb<f64, 2>) -> Vec<u32> {
+        (0..sweep.volumes.len())
+            .filter(|&j| j != i && overlap(&sweep.volumes[j], query))
+            .map(|j| j as u32)
+            .collect()
+    }
+
+    fn sorted(mut v: Vec<u32>) -> Vec<u32> {
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+
+    #[test]
+    fn partner_lists_are_the_pairs_of_each_ball() {
+        let (balls, sweep) = built(0.2);
+        let mut partners = 0;
+        for i in 0..balls.len() {
+            let list = sweep.partners[sweep.partner_start[i]..sweep.partner_start[i + 1]].to_vec();
+            let expected = brute(&sweep, i, &sweep.volumes[i]);
+            partners += list.len();
+            assert_eq!(
+                sorted(list.clone()).len(),
+                list.len(),
+                "ball {i} lists a partner twice"
+            );
+            assert_eq!(sorted(list), expected, "ball {i}");
+        }
+        // A dense gas: each ball has a few partners, not all the others.
+        assert!(
+            balls.len() < partners && partners < 20 * balls.len(),
+            "{partners} partners"
+        );
+    }
+
+    /// The candidates of a path inside a ball's entry (its partners) and of a path
+    /// outside it (a query) hold every volume and every escapee the path meets.
+    #[test]
+    fn candidates_hold_everything_a_path_meets() {
+        let (balls, mut sweep) = built(0.2);
+        let n = balls.len();
+        // Ten balls escape: their paths now reach three metres to the right, among
+        // other balls.
+        let escapees: Vec<usize> = (0..10).map(|k| 7 + 97 * k).collect();
+        for &e in &escapees {
+            let x = balls.position_at(e, 0.0);
+            sweep.moved(e, path_box(&x, &(x + Vector::from([3.0, 0.0])), 0.5));
+        }
+        assert_eq!(sweep.escapees().len(), escapees.len());
+        let mut out = Vec::new();
+        let mut through_partners = 0;
+        for i in 0..n {
+            let path = if escapees.contains(&i) {
+                *sweep.box_of(i)
+            } else {
+                reach_box(&balls.position_at(i, 0.0), balls.radius[i], 0.1)
+            };
+            through_partners += usize::from(contains(&sweep.volumes[i], &path));
+            sweep.candidates(i, &path, &mut out);
+            let got = sorted(out.iter().copied().filter(|&c| c as usize != i).collect());
+            let mut expected = brute(&sweep, i, &path);
+            expected.extend(
+                escapees
+                    .iter()
+                    .filter(|&&e| e != i && overlap(sweep.box_of(e), &path))
+                    .map(|&e| e as u32),
+            );
+            let expected = sorted(expected);
+            let missing: Vec<_> = expected
+                .iter()
+                .filter(|c| got.binary_search(c).is_err())
+                .collect();
+            assert!(missing.is_empty(), "ball {i} misses {missing:?}");
+        }
+        assert_eq!(through_partners, n - escapees.len());
+    }
 }
