@@ -41,6 +41,7 @@
 
 mod balls;
 mod clusters;
+mod escapees;
 mod forces;
 mod narrow;
 mod obstacles;
@@ -705,6 +706,9 @@ where
         let path = path_box(&x, &b.pos[i], r + tolerance);
         let mut candidates = core::mem::take(&mut self.candidates);
         self.sweep.candidates(i, &path, &mut candidates);
+        // Ascending, each once: the supports come in index order whatever the source.
+        candidates.sort_unstable();
+        candidates.dedup();
         let g = self.rules.gravity;
         let boxes = if self.sweep.boxes_inside() {
             None

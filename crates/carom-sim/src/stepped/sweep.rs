@@ -36,6 +36,7 @@ use nalgebra::Const;
 use rayon::prelude::*;
 
 use super::balls::BallArrays;
+use super::escapees::Escapees;
 use super::obstacles::BoxArrays;
 use crate::plan::BroadChoice;
 
@@ -73,16 +74,9 @@ pub(crate) struct Sweep<T: Real, const D: usize> {
     /// are `partners[partner_start[i]..partner_start[i + 1]]`.
     partner_start: Vec<usize>,
     partners: Vec<u32>,
-    /// The escapees, in the order they escaped, and their boxes (kept side by side so
-    /// that a scan reads one contiguous array).
-    escaped: Vec<u32>,
-    escape_boxes: Vec<Aabb<T, D>>,
-    /// Per ball: its index in `escaped`, or [`NOT_ESCAPED`].
-    escape_slot: Vec<u32>,
+    /// The balls whose paths left their entries.
+    escapees: Escapees<T, D>,
 }
-
-/// The `escape_slot` of a ball that has not escaped.
-const NOT_ESCAPED: u32 = u32::MAX;
 
 impl<T: Real, const D: usize> Sweep<T, D>
 where
@@ -113,9 +107,7 @@ where
             pairs: Vec::new(),
             partner_start: Vec::with_capacity(n + 1),
             partners: Vec::new(),
-            escaped: Vec::new(),
-            escape_boxes: Vec::new(),
-            escape_slot: vec![NOT_ESCAPED; n],
+            escapees: Escapees::new(n),
         }
     }
 
@@ -146,7 +138,7 @@ where
         escape_bound: usize,
         parallel: bool,
     ) {
-        self.clear_escapees();
+        self.escapees.clear();
         if self.built && self.boxes_fit(boxes, h) {
             let n = balls.len();
             let chunks = n.div_ceil(CHUNK);
@@ -177,13 +169,14 @@ where
             }
             for &i in misfits[..chunks].iter().flatten().take(escape_bound) {
                 let i = i as usize;
-                self.escape(i, path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]));
+                let path = path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]);
+                self.escapees.set(i, path);
             }
             self.misfits = misfits;
-            if self.escaped.len() < escape_bound {
+            if self.escapees.len() < escape_bound {
                 return;
             }
-            self.clear_escapees();
+            self.escapees.clear();
         }
         let steps = self.reach_steps(balls, h, parallel);
         self.build(balls, boxes, T::zero(), h * T::from_count(steps), parallel);
@@ -209,22 +202,6 @@ where
                 .all(|k| contains(&self.volumes[self.balls + k], &boxes.swept(k, T::zero(), h)))
     }
 
-    fn clear_escapees(&mut self) {
-        for &e in &self.escaped {
-            self.escape_slot[e as usize] = NOT_ESCAPED;
-        }
-        self.escaped.clear();
-        self.escape_boxes.clear();
-    }
-
-    /// Lists ball `i` (not an escapee yet) as an escapee with box `path`.
-    fn escape(&mut self, i: usize, path: Aabb<T, D>) {
-        // The escapees are fewer than the balls, whose count fits in u32.
-        self.escape_slot[i] = self.escaped.len() as u32;
-        self.escaped.push(i as u32);
-        self.escape_boxes.push(path);
-    }
-
     /// Rebuilds from the balls' paths at in-step time `a`, each ball reaching as far as
     /// it travels in `reach` (at least the mean travel), plus the boxes swept over the
     /// same time (open space only), and finds the pairs.
@@ -237,7 +214,6 @@ where
         parallel: bool,
     ) {
         let n = balls.len();
-        self.clear_escapees();
         let mean = chunked_sum(&balls.chord, parallel, &mut self.sums, Vector::norm)
             / T::from_count(n.max(1));
         self.volumes
@@ -263,6 +239,8 @@ where
             self.volumes
                 .extend((0..boxes.len()).map(|k| boxes.swept(k, a, a + reach)));
         }
+        let (lo, hi) = first_axis_extent(&self.volumes, parallel);
+        self.escapees.span(lo, hi);
         // Counts below u32::MAX are checked when the engine is built.
         let volumes = Volumes::Boxes(&self.volumes);
         if parallel {
@@ -321,10 +299,7 @@ where
 
     /// Ball `i`'s escapee box if it escaped, its entry otherwise.
     fn box_of(&self, i: usize) -> &Aabb<T, D> {
-        match self.escape_slot[i] {
-            NOT_ESCAPED => &self.volumes[i],
-            slot => &self.escape_boxes[slot as usize],
-        }
+        self.escapees.box_of(i).unwrap_or(&self.volumes[i])
     }
 
     /// Records that ball `i`'s remaining path now has the box `path`: if it leaves the
@@ -332,12 +307,9 @@ where
     /// number of escapees.
     pub(crate) fn moved(&mut self, i: usize, path: Aabb<T, D>) -> usize {
         if !self.holds(i, &path) {
-            match self.escape_slot[i] {
-                NOT_ESCAPED => self.escape(i, path),
-                slot => self.escape_boxes[slot as usize] = path,
-            }
+            self.escapees.set(i, path);
         }
-        self.escaped.len()
+        self.escapees.len()
     }
 
     /// The balls' entries (then the boxes').
@@ -347,7 +319,7 @@ where
 
     /// The escapees, in the order they escaped.
     pub(crate) fn escapees(&self) -> &[u32] {
-        &self.escaped
+        self.escapees.balls()
     }
 
     /// The candidates ball `i`, whose remaining path (or a box around it) is `path`, can
@@ -359,17 +331,32 @@ where
     /// can touch `path` keeps its own path in its entry (or is an escapee), so its entry
     /// meets `i`'s and the two are a pair. Otherwise the broad phase is queried.
     pub(crate) fn candidates(&self, i: usize, path: &Aabb<T, D>, out: &mut Vec<u32>) {
-        if self.escape_slot[i] == NOT_ESCAPED && contains(&self.volumes[i], path) {
+        if self.escapees.box_of(i).is_none() && contains(&self.volumes[i], path) {
             out.clear();
             out.extend_from_slice(&self.partners[self.partner_start[i]..self.partner_start[i + 1]]);
         } else {
             self.phase.query_aabb(path, out);
         }
-        for (&e, b) in self.escaped.iter().zip(&self.escape_boxes) {
-            if overlap(b, path) {
-                out.push(e);
-            }
-        }
+        self.escapees.meeting(path, out);
+    }
+}
+
+/// The smallest and largest first coordinates of `boxes` (exact in any order).
+fn first_axis_extent<T: Real, const D: usize>(boxes: &[Aabb<T, D>], parallel: bool) -> (T, T) {
+    let extent = |part: &[Aabb<T, D>]| {
+        part.iter()
+            .fold((T::INFINITY, -T::INFINITY), |(lo, hi), b| {
+                (lo.min(b.min()[0]), hi.max(b.max()[0]))
+            })
+    };
+    let merge = |a: (T, T), b: (T, T)| (a.0.min(b.0), a.1.max(b.1));
+    if parallel {
+        boxes
+            .par_chunks(CHUNK)
+            .map(extent)
+            .reduce(|| (T::INFINITY, -T::INFINITY), merge)
+    } else {
+        extent(boxes)
     }
 }
 

@@ -1,0 +1,250 @@
+//! The escapees of the broad phase: balls whose paths left their entries, each with the
+//! box its remaining path now lies in, and a lookup of the escapees whose boxes meet a
+//! query box.
+//!
+//! Every prediction in a step asks which escapees its path can meet, and the list grows
+//! to a sixteenth of the balls before the broad phase is rebuilt, so a scan of all of
+//! them would cost each prediction hundreds of box tests. The boxes are therefore also
+//! filed in **lanes**: equal slices of the first axis over the extent of the entries at
+//! the last build. A box is filed in every lane its first-axis interval meets (clamped
+//! to the first and last lane), or, spanning more than [`MAX_LANES_PER_BOX`] lanes, in a
+//! short list of wide boxes that every lookup scans. Two boxes that overlap share a point
+//! of the first axis, whose clamped lane holds both, so a lookup that reads the lanes of
+//! the query and the wide list misses none. A box that changes is filed again; its old
+//! filings stay until the next clear and only cost an extra test.
+
+use carom_geometry::Aabb;
+use carom_math::Real;
+
+use super::sweep::overlap;
+
+/// The most lanes a box is filed in; wider boxes go to the wide list.
+const MAX_LANES_PER_BOX: usize = 8;
+
+/// The lane count for `n` balls: about 64 balls' entries per lane, at least 1 and at
+/// most 4096 lanes.
+fn lane_count(n: usize) -> usize {
+    (n / 64).clamp(1, 4096)
+}
+
+/// The `index` of a ball that has not escaped.
+const NOT_ESCAPED: u32 = u32::MAX;
+
+/// The escapees and their boxes (see the [module documentation](self)).
+pub(crate) struct Escapees<T: Real, const D: usize> {
+    /// The escapees, in the order they escaped.
+    balls: Vec<u32>,
+    /// Their boxes, side by side with `balls`.
+    boxes: Vec<Aabb<T, D>>,
+    /// Per ball: its index in `balls`, or [`NOT_ESCAPED`].
+    index: Vec<u32>,
+    /// Per lane: indices into `balls` of the boxes filed there.
+    lanes: Vec<Vec<u32>>,
+    /// The lanes holding something (to clear).
+    used: Vec<u32>,
+    /// Indices into `balls` of the boxes too wide for lanes.
+    wide: Vec<u32>,
+    /// The first axis' start of lane 0.
+    origin: T,
+    /// Lanes per metre of the first axis.
+    density: T,
+}
+
+impl<T: Real, const D: usize> Escapees<T, D> {
+    /// No escapees among `n` balls, with one lane until [`Escapees::span`] is called.
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            balls: Vec::new(),
+            boxes: Vec::new(),
+            index: vec![NOT_ESCAPED; n],
+            lanes: vec![Vec::new(); lane_count(n)],
+            used: Vec::new(),
+            wide: Vec::new(),
+            origin: T::zero(),
+            density: T::zero(),
+        }
+    }
+
+    /// Lays the lanes over `[lo, hi]` of the first axis and forgets every escapee.
+    pub(crate) fn span(&mut self, lo: T, hi: T) {
+        self.clear();
+        let width = hi - lo;
+        self.origin = lo;
+        self.density = if width > T::zero() && width.finite() {
+            T::from_count(self.lanes.len()) / width
+        } else {
+            T::zero()
+        };
+    }
+
+    /// Forgets every escapee.
+    pub(crate) fn clear(&mut self) {
+        for &e in &self.balls {
+            self.index[e as usize] = NOT_ESCAPED;
+        }
+        self.balls.clear();
+        self.boxes.clear();
+        for &lane in &self.used {
+            self.lanes[lane as usize].clear();
+        }
+        self.used.clear();
+        self.wide.clear();
+    }
+
+    /// The number of escapees.
+    pub(crate) fn len(&self) -> usize {
+        self.balls.len()
+    }
+
+    /// The escapees, in the order they escaped.
+    pub(crate) fn balls(&self) -> &[u32] {
+        &self.balls
+    }
+
+    /// Ball `i`'s box if it escaped.
+    pub(crate) fn box_of(&self, i: usize) -> Option<&Aabb<T, D>> {
+        match self.index[i] {
+            NOT_ESCAPED => None,
+            k => Some(&self.boxes[k as usize]),
+        }
+    }
+
+    /// Makes ball `i` an escapee (or keeps it one) with the box `path`.
+    pub(crate) fn set(&mut self, i: usize, path: Aabb<T, D>) {
+        let k = match self.index[i] {
+            NOT_ESCAPED => {
+                // Escapees are fewer than the balls, whose count fits in u32.
+                let k = self.balls.len() as u32;
+                self.index[i] = k;
+                self.balls.push(i as u32);
+                self.boxes.push(path);
+                k
+            }
+            k => {
+                self.boxes[k as usize] = path;
+                k
+            }
+        };
+        let lanes = self.lanes_of(&path);
+        if lanes.len() > MAX_LANES_PER_BOX {
+            self.wide.push(k);
+            return;
+        }
+        for lane in lanes {
+            if self.lanes[lane].is_empty() {
+                self.used.push(lane as u32);
+            }
+            self.lanes[lane].push(k);
+        }
+    }
+
+    /// Appends to `out` every escapee whose box meets `query` (some more than once).
+    pub(crate) fn meeting(&self, query: &Aabb<T, D>, out: &mut Vec<u32>) {
+        let mut test = |k: u32| {
+            if overlap(&self.boxes[k as usize], query) {
+                out.push(self.balls[k as usize]);
+            }
+        };
+        let lanes = self.lanes_of(query);
+        if lanes.len() > MAX_LANES_PER_BOX {
+            // A wide query tests every escapee once.
+            (0..self.balls.len() as u32).for_each(test);
+            return;
+        }
+        self.wide.iter().for_each(|&k| test(k));
+        for lane in &self.lanes[lanes] {
+            lane.iter().for_each(|&k| test(k));
+        }
+    }
+
+    /// The lanes the first-axis interval of `b` meets, clamped to the lanes there are.
+    fn lanes_of(&self, b: &Aabb<T, D>) -> core::ops::Range<usize> {
+        let last = self.lanes.len() - 1;
+        let lane = |x: T| {
+            let at = ((x - self.origin) * self.density).floor();
+            if at >= T::zero() {
+                // NaN-free boxes; `as` saturates past the last lane.
+                (at.to_f64() as usize).min(last)
+            } else {
+                0
+            }
+        };
+        lane(b.min()[0])..lane(b.max()[0]) + 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use carom_math::Vector;
+
+    use super::*;
+    use crate::scenes::SplitMix64;
+
+    /// A box of half size `half` around `(x, y)`.
+    fn square(x: f64, y: f64, half: f64) -> Aabb<f64, 2> {
+        let h = Vector::from([half, half]);
+        let c = Vector::from([x, y]);
+        Aabb::new_unchecked(c - h, c + h)
+    }
+
+    /// A random box: mostly small, some wide, some outside the span `[0, 100]`.
+    fn random_box(g: &mut SplitMix64) -> Aabb<f64, 2> {
+        let half = match g.next_u64() % 10 {
+            0 => g.range(10.0, 80.0),
+            1 => 0.0,
+            _ => g.range(0.1, 3.0),
+        };
+        square(g.range(-20.0, 120.0), g.range(0.0, 100.0), half)
+    }
+
+    /// Lookups find exactly the escapees whose current boxes meet the query (after
+    /// repeats are removed), for boxes in one lane, several, the wide list, past either
+    /// end of the span, points, and boxes that changed.
+    #[test]
+    fn lookups_match_brute_force() {
+        let n = 2000;
+        let mut g = SplitMix64::new(99);
+        let mut escapees = Escapees::<f64, 2>::new(n);
+        escapees.span(0.0, 100.0);
+        let mut current = vec![None; n];
+        for step in 0..600 {
+            let i = (g.next_u64() % n as u64) as usize;
+            let b = random_box(&mut g);
+            escapees.set(i, b);
+            current[i] = Some(b);
+            if step % 3 != 0 {
+                continue;
+            }
+            let query = random_box(&mut g);
+            let mut found = Vec::new();
+            escapees.meeting(&query, &mut found);
+            found.sort_unstable();
+            found.dedup();
+            let expected: Vec<u32> = (0..n)
+                .filter(|&k| current[k].is_some_and(|b| overlap(&b, &query)))
+                .map(|k| k as u32)
+                .collect();
+            assert_eq!(found, expected, "query {query:?} after {step} escapes");
+        }
+        assert!(!escapees.wide.is_empty() && escapees.len() > 400);
+        escapees.clear();
+        let mut found = Vec::new();
+        escapees.meeting(&square(50.0, 50.0, 100.0), &mut found);
+        assert!(found.is_empty() && escapees.len() == 0);
+        assert!(escapees.lanes.iter().all(Vec::is_empty));
+    }
+
+    /// Without a usable span (one point, or nothing) every box shares lane 0.
+    #[test]
+    fn a_degenerate_span_keeps_one_lane() {
+        let mut escapees = Escapees::<f64, 2>::new(200);
+        escapees.span(f64::INFINITY, f64::NEG_INFINITY);
+        escapees.set(3, square(5.0, 5.0, 1.0));
+        escapees.set(4, square(-5.0, 5.0, 1.0));
+        let mut found = Vec::new();
+        escapees.meeting(&square(5.5, 5.0, 0.1), &mut found);
+        assert_eq!(found, [3]);
+        assert_eq!(escapees.box_of(4), Some(&square(-5.0, 5.0, 1.0)));
+        assert_eq!(escapees.box_of(5), None);
+    }
+}
