@@ -151,9 +151,8 @@ impl<T: Real, const D: usize> Escapees<T, D> {
             (0..self.balls.len() as u32).for_each(test);
             return;
         }
-        self.wide.iter().for_each(|&k| test(k));
-        for lane in &self.lanes[lanes] {
-            lane.iter().for_each(|&k| test(k));
+        for &k in self.wide.iter().chain(self.lanes[lanes].iter().flatten()) {
+            test(k);
         }
     }
 
