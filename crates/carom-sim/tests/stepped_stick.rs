@@ -1,7 +1,8 @@
 //! Stuck clusters in the time-stepped engine (`inelastic = "stick"`), 2D and 3D: fusion
 //! against the closed form of a perfectly inelastic collision with spin, rigid motion,
-//! walls and floors, torque-free tumbling, agreement with the exact event engine, and
-//! determinism.
+//! walls and floors, torque-free tumbling, a cluster struck by a ball with restitution
+//! above 0, drag on a spinning cluster, backward runs, agreement with the exact event
+//! engine, and determinism.
 
 mod common;
 
@@ -723,4 +724,231 @@ fn a_cluster_spanning_half_a_periodic_box_stops_the_run_naming_the_border() {
     });
     let mut sim = stepped(&roomy, Integrator::SemiImplicitEuler, DT);
     sim.advance_to(2.0, &mut Recorder::default()).unwrap();
+}
+
+/// Balls 0 (restitution 0) and 1 (restitution 0.8) stick head-on into a pair that drifts
+/// along `+x` without spin; ball 2 (restitution 0.8), falling along `−y`, then strikes
+/// ball 1 off the pair's centre: a rigid-body collision of restitution 0.8.
+fn cluster_meets_ball() -> Scene<f64, 2> {
+    let mut a = BallSpec::new(Vector2::zeros(), Vector2::new(0.5, 0.0), 0.1, 1.0);
+    a.restitution = Some(0.0);
+    let b = BallSpec::new(Vector2::new(0.5, 0.0), Vector2::zeros(), 0.1, 1.0);
+    let c = BallSpec::new(Vector2::new(0.9, 2.2), Vector2::new(0.0, -1.0), 0.1, 0.5);
+    Scene {
+        world: World {
+            restitution: 0.8,
+            ..world()
+        },
+        balls: vec![a, b, c],
+        ..Scene::default()
+    }
+}
+
+/// Mass, centre, velocity and spin of the balls `members`, and their inertia about the
+/// centre (disks plus the parallel-axis terms), from the reported states.
+fn rigid_part(
+    s: &Scene<f64, 2>,
+    st: &BallStates<f64, 2>,
+    members: &[usize],
+) -> (f64, Vector2<f64>, Vector2<f64>, f64, f64) {
+    let mass: f64 = members.iter().map(|&k| s.balls[k].mass).sum();
+    let c = members
+        .iter()
+        .map(|&k| st.pos[k] * s.balls[k].mass)
+        .sum::<Vector2<f64>>()
+        / mass;
+    let v = members
+        .iter()
+        .map(|&k| st.vel[k] * s.balls[k].mass)
+        .sum::<Vector2<f64>>()
+        / mass;
+    let inertia = members
+        .iter()
+        .map(|&k| {
+            let b = &s.balls[k];
+            0.5 * b.mass * b.radius * b.radius + b.mass * (st.pos[k] - c).norm_squared()
+        })
+        .sum();
+    (mass, c, v, st.spin[members[0]].x, inertia)
+}
+
+#[test]
+fn a_cluster_and_a_ball_collide_with_restitution_above_zero_as_the_rigid_body_impulse_says() {
+    let s = cluster_meets_ball();
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    let mut rec = Recorder::default();
+    let mut before = None;
+    let mut after = None;
+    let mut k = 1;
+    while after.is_none() && k < 3000 {
+        let st_prev = states(&sim);
+        sim.advance_to(f64::from(k) * DT, &mut rec).unwrap();
+        let hits: Vec<_> = rec
+            .collisions
+            .iter()
+            .filter_map(|c| match *c {
+                Collision::BallBall { time, i, j } => Some((time, i, j)),
+                _ => None,
+            })
+            .collect();
+        match (hits.len(), before.is_some()) {
+            (2, false) => before = Some((f64::from(k - 1) * DT, st_prev, hits[1])),
+            (2, true) => after = Some(states(&sim)),
+            _ => {}
+        }
+        k += 1;
+    }
+    let (t_b, st_b, (t_hit, i, j)) = before.expect("ball 2 reaches the pair");
+    assert_eq!((i, j), (1, 2), "ball 2 strikes ball 1, not ball 0");
+    let st_a = after.expect("a step after the collision");
+    // Before: a rigid pair (the head-on fusion left it without spin) and a free ball,
+    // both in straight flight: their poses at the contact follow exactly.
+    let (mass, c, v, w, inertia) = rigid_part(&s, &st_b, &[0, 1]);
+    assert!(w.abs() < 1e-12, "a head-on fusion does not spin: {w}");
+    let dt = t_hit - t_b;
+    let (x1, x2) = (st_b.pos[1] + v * dt, st_b.pos[2] + st_b.vel[2] * dt);
+    let n = (x2 - x1).normalize();
+    assert!(
+        ((x2 - x1).norm() - 0.2).abs() < 1e-9,
+        "touching at the contact"
+    );
+    // The impulse J n on ball 2 (−J n on the pair at the contact point, arm r from the
+    // pair's centre): J = −(1 + e) u·n / (1/m + 1/M + (r × n)²/I), u the approach.
+    let e = 0.8;
+    let r = x1 + n * 0.1 - (c + v * dt);
+    let u = st_b.vel[2] - v;
+    let rn = r.x * n.y - r.y * n.x;
+    let m = s.balls[2].mass;
+    let impulse = -(1.0 + e) * u.dot(&n) / (1.0 / m + 1.0 / mass + rn * rn / inertia);
+    let v2 = st_b.vel[2] + n * (impulse / m);
+    let v_pair = v - n * (impulse / mass);
+    let w_pair = -rn * impulse / inertia;
+    let (_, _, v_after, w_after, _) = rigid_part(&s, &st_a, &[0, 1]);
+    assert!((st_a.vel[2] - v2).norm() < 1e-9, "{} vs {v2}", st_a.vel[2]);
+    assert!((v_after - v_pair).norm() < 1e-9, "{v_after} vs {v_pair}");
+    assert!(
+        (w_after - w_pair).abs() < 1e-9 * w_pair.abs().max(1.0),
+        "{w_after} vs {w_pair}"
+    );
+    assert!(
+        w_pair.abs() > 0.1,
+        "an off-centre blow spins the pair: {w_pair}"
+    );
+    // Momentum is kept; the energy lost is (1 − e²) of the normal approach's share.
+    let (p_b, _, _, e_b) = invariants(&s, &st_b);
+    let (p_a, _, _, e_a) = invariants(&s, &st_a);
+    assert!((p_a - p_b).norm() < 1e-12, "{p_b} -> {p_a}");
+    let reduced = 1.0 / (1.0 / m + 1.0 / mass + rn * rn / inertia);
+    let lost = 0.5 * reduced * u.dot(&n).powi(2) * (1.0 - e * e);
+    assert!(
+        (e_b - e_a - lost).abs() < 1e-9,
+        "lost {} vs {lost}",
+        e_b - e_a
+    );
+}
+
+/// Two equal balls thrown at each other off-centre stick into a spinning pair in a world
+/// with linear drag `k` per ball.
+fn dragged_pair(k: f64) -> Scene<f64, 2> {
+    Scene {
+        world: World { drag: k, ..world() },
+        balls: vec![
+            BallSpec::new(Vector2::zeros(), Vector2::new(0.6, 0.1), 0.1, 1.0),
+            BallSpec::new(Vector2::new(0.6, 0.12), Vector2::new(-0.4, 0.0), 0.1, 1.0),
+        ],
+        ..Scene::default()
+    }
+}
+
+/// The pair's centre velocity and spin `span` seconds after the first step end past the
+/// fusion, stepped at `dt`, with the values the closed form gives from that step end.
+fn drag_decay(dt: f64, span: f64) -> ((Vector2<f64>, f64), (Vector2<f64>, f64)) {
+    let k = 0.7;
+    let s = dragged_pair(k);
+    let mut sim = stepped(&s, Integrator::Exact, dt);
+    let mut rec = Recorder::default();
+    let mut step = 1;
+    while rec.collisions.is_empty() {
+        sim.advance_to(f64::from(step) * dt, &mut rec).unwrap();
+        step += 1;
+    }
+    let t0 = f64::from(step - 1) * dt;
+    let (mass, _, v0, w0, inertia) = rigid_part(&s, &states(&sim), &[0, 1]);
+    let arms: f64 = {
+        let st = states(&sim);
+        let (_, c, _, _, _) = rigid_part(&s, &st, &[0, 1]);
+        st.pos.iter().map(|x| (x - c).norm_squared()).sum()
+    };
+    sim.advance_to(t0 + span, &mut ()).unwrap();
+    let (_, _, v, w, _) = rigid_part(&s, &states(&sim), &[0, 1]);
+    // Equal members about their centre: the drag forces sum to −2k v (no coupling to
+    // the spin) and their torque is −k ω Σ|rᵢ|².
+    let expected_v = v0 * (-2.0 * k / mass * span).exp();
+    let expected_w = w0 * (-k * arms / inertia * span).exp();
+    ((v, w), (expected_v, expected_w))
+}
+
+#[test]
+fn a_spinning_cluster_under_drag_slows_down_and_spins_down_as_the_closed_forms_say() {
+    let span = 2.0;
+    let ((v, w), (v_exact, w_exact)) = drag_decay(DT, span);
+    assert!(
+        w_exact.abs() > 0.1 && v_exact.norm() > 0.01,
+        "a moving, spinning pair"
+    );
+    // The centre's motion is stepped by the exact integrator: rounding only.
+    assert!((v - v_exact).norm() < 1e-12, "{v} vs {v_exact}");
+    // The drag torque is integrated to first order: the error halves with the step.
+    let coarse = (w - w_exact).abs();
+    let ((_, w_fine), (_, w_fine_exact)) = drag_decay(DT / 2.0, span);
+    let fine = (w_fine - w_fine_exact).abs();
+    assert!(coarse < 1e-3 * w_exact.abs(), "spin error {coarse}");
+    assert!(
+        fine < 0.6 * coarse && fine > 0.4 * coarse,
+        "first order: {coarse:e} at dt, {fine:e} at dt/2"
+    );
+}
+
+#[test]
+fn a_backward_run_with_clusters_is_the_forward_run_of_the_reversed_scene_mirrored() {
+    let s = cluster_meets_ball();
+    let mut reversed = s.clone();
+    for b in &mut reversed.balls {
+        b.vel = -b.vel;
+    }
+    let t = 2.5;
+    // Run backward from the reversed scene: its time-reversed equations are the forward
+    // equations of `s`.
+    let mut backward = common::stepped_with(
+        &reversed,
+        Integrator::SemiImplicitEuler,
+        DT,
+        carom_sim::plan::BroadChoice::Auto,
+        Direction::Backward,
+    );
+    let mut rec = Recorder::default();
+    backward.advance_to(-t, &mut rec).unwrap();
+    let mut forward = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    forward.advance_to(t, &mut ()).unwrap();
+    // The pair formed and ball 2 struck it in both runs.
+    assert_eq!(backward.counters().ball_ball, 2);
+    assert_eq!(forward.counters().ball_ball, 2);
+    let (b, f) = (states(&backward), states(&forward));
+    for k in 0..3 {
+        assert!(
+            (b.pos[k] - f.pos[k]).norm() < 1e-12,
+            "ball {k}: {} vs {}",
+            b.pos[k],
+            f.pos[k]
+        );
+        assert!(
+            (b.vel[k] + f.vel[k]).norm() < 1e-12,
+            "ball {k}: {} vs −{}",
+            b.vel[k],
+            f.vel[k]
+        );
+        assert!((b.spin[k].x + f.spin[k].x).abs() < 1e-12, "ball {k} spin");
+    }
+    assert!(b.spin[0].x.abs() > 0.1, "the backward pair spins");
+    assert!(rec.collisions.iter().all(|c| c.time() < 0.0));
 }
