@@ -208,15 +208,8 @@ fn rigid_2d(
     s: &Scene<f64, 2>,
     st: &BallStates<f64, 2>,
 ) -> (f64, Vector2<f64>, Vector2<f64>, f64, f64) {
-    let (p, c, _, _) = invariants(s, st);
-    let mass: f64 = s.balls.iter().map(|b| b.mass).sum();
-    let inertia = s
-        .balls
-        .iter()
-        .zip(&st.pos)
-        .map(|(b, x)| 0.5 * b.mass * b.radius * b.radius + b.mass * (x - c).norm_squared())
-        .sum();
-    (mass, c, p / mass, st.spin[0].x, inertia)
+    let all: Vec<usize> = (0..s.balls.len()).collect();
+    rigid_part(s, st, &all)
 }
 
 #[test]
@@ -744,8 +737,8 @@ fn cluster_meets_ball() -> Scene<f64, 2> {
     }
 }
 
-/// Mass, centre, velocity and spin of the balls `members`, and their inertia about the
-/// centre (disks plus the parallel-axis terms), from the reported states.
+/// Mass, centre, velocity and spin of the rigid group `members` (2D), and its inertia
+/// about the centre (disks plus the parallel-axis terms), from the reported states.
 fn rigid_part(
     s: &Scene<f64, 2>,
     st: &BallStates<f64, 2>,
@@ -873,12 +866,9 @@ fn drag_decay(dt: f64, span: f64) -> ((Vector2<f64>, f64), (Vector2<f64>, f64)) 
         step += 1;
     }
     let t0 = f64::from(step - 1) * dt;
-    let (mass, _, v0, w0, inertia) = rigid_part(&s, &states(&sim), &[0, 1]);
-    let arms: f64 = {
-        let st = states(&sim);
-        let (_, c, _, _, _) = rigid_part(&s, &st, &[0, 1]);
-        st.pos.iter().map(|x| (x - c).norm_squared()).sum()
-    };
+    let st = states(&sim);
+    let (mass, c, v0, w0, inertia) = rigid_part(&s, &st, &[0, 1]);
+    let arms: f64 = st.pos.iter().map(|x| (x - c).norm_squared()).sum();
     sim.advance_to(t0 + span, &mut ()).unwrap();
     let (_, _, v, w, _) = rigid_part(&s, &states(&sim), &[0, 1]);
     // Equal members about their centre: the drag forces sum to −2k v (no coupling to
