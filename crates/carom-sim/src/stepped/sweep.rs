@@ -261,15 +261,16 @@ where
     }
 
     /// Turns the pair list into per-ball partner lists (a counting sort: both balls of a
-    /// pair list each other; a ball lists a box, never the reverse).
+    /// pair list each other; a ball lists a box, never the reverse; two boxes, nothing).
     fn link_partners(&mut self) {
         let n = self.balls;
         self.partner_start.clear();
         self.partner_start.resize(n + 1, 0);
         for &(i, j) in &self.pairs {
-            self.partner_start[i as usize + 1] += 1;
-            if (j as usize) < n {
-                self.partner_start[j as usize + 1] += 1;
+            for ball in [i, j] {
+                if (ball as usize) < n {
+                    self.partner_start[ball as usize + 1] += 1;
+                }
             }
         }
         for i in 0..n {
@@ -279,11 +280,11 @@ where
         // `next[i]` runs from `partner_start[i]` up as ball i's list fills.
         let mut next = core::mem::take(&mut self.partner_start);
         for &(i, j) in &self.pairs {
-            self.partners[next[i as usize]] = j;
-            next[i as usize] += 1;
-            if (j as usize) < n {
-                self.partners[next[j as usize]] = i;
-                next[j as usize] += 1;
+            for (ball, other) in [(i, j), (j, i)] {
+                if (ball as usize) < n {
+                    self.partners[next[ball as usize]] = other;
+                    next[ball as usize] += 1;
+                }
             }
         }
         // Each `next[i]` ended at ball i's end, which is ball i + 1's start.
@@ -453,7 +454,8 @@ mod tests {
             ..GasParams::default()
         })
         .unwrap();
-        for (x, angle) in [(-5.0, 0.3), (6.0, 0.0)] {
+        // Two of the boxes overlap: a box–box pair lists nothing.
+        for (x, angle) in [(-5.0, 0.3), (6.0, 0.0), (6.3, 0.5)] {
             scene.boxes.push(BoxSpec {
                 shape: Obb::from_angle(Vector::from([x, 1.0]), Vector::from([0.2, 3.0]), angle)
                     .unwrap(),
