@@ -12,12 +12,11 @@
 
 #![cfg(feature = "rapier")]
 
-use carom_geometry::Border;
 use carom_integrate::Integrator;
 use carom_report::engines::{self, Method};
 use carom_report::peer::rapier::RapierScene;
 use carom_report::reference::{self, FreeBall};
-use carom_sim::scene::{BallSpec, BorderSpec, Scene, World};
+use carom_sim::scene::{BallSpec, Scene};
 use carom_sim::scenes::classic;
 use carom_sim::scenes::gas::{GasParams, gas};
 use carom_sim::{BallStates, observe};
@@ -280,23 +279,6 @@ fn newtons_cradle_passes_the_whole_momentum_to_the_last_ball() {
     }
 }
 
-/// A box `[-1, 1]²` with elastic walls, and `balls` in it.
-fn boxed(balls: Vec<BallSpec<f64, 2>>) -> Scene<f64, 2> {
-    Scene {
-        name: Some("box".to_owned()),
-        world: World {
-            border: Some(BorderSpec {
-                border: Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0)).unwrap(),
-                restitution: 1.0,
-                periodic: false,
-            }),
-            ..World::default()
-        },
-        balls,
-        boxes: Vec::new(),
-    }
-}
-
 #[test]
 fn fast_balls_bounce_off_walls_where_the_unfolded_line_says() {
     // 1e3 and 1e4 m/s in a 2 m box: 10 to 100 m per step of 1/60 s, tens to hundreds
@@ -304,7 +286,7 @@ fn fast_balls_bounce_off_walls_where_the_unfolded_line_says() {
     for speed in [1e3, 1e4] {
         let r = 0.1;
         let vel = Vector2::new(speed, 0.37 * speed);
-        let s = boxed(vec![BallSpec::new(Vector2::new(0.2, -0.3), vel, r, 1.0)]);
+        let s = classic::elastic_box(vec![BallSpec::new(Vector2::new(0.2, -0.3), vel, r, 1.0)]);
         let t = 6.0 * DT;
         let (x, vx) = reference::between_walls(0.2, vel.x, -1.0, 1.0, r, t);
         let (y, vy) = reference::between_walls(-0.3, vel.y, -1.0, 1.0, r, t);

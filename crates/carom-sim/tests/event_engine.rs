@@ -166,23 +166,10 @@ fn a_slow_closing_across_a_tiny_gap_is_one_exact_collision_not_a_false_one() {
 
 #[test]
 fn balls_at_a_million_metres_per_second_never_leave_the_box_or_pass_each_other() {
-    let border = Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0)).unwrap();
-    let scene = Scene {
-        name: None,
-        world: World {
-            border: Some(BorderSpec {
-                border,
-                restitution: 1.0,
-                periodic: false,
-            }),
-            ..World::default()
-        },
-        balls: vec![
-            BallSpec::new(Vector2::new(-0.5, 0.0), Vector2::new(1e6, 3.7e5), 0.05, 1.0),
-            BallSpec::new(Vector2::new(0.5, 0.0), Vector2::new(-1e6, 1.3e5), 0.05, 1.0),
-        ],
-        boxes: Vec::new(),
-    };
+    let scene = classic::elastic_box(vec![
+        BallSpec::new(Vector2::new(-0.5, 0.0), Vector2::new(1e6, 3.7e5), 0.05, 1.0),
+        BallSpec::new(Vector2::new(0.5, 0.0), Vector2::new(-1e6, 1.3e5), 0.05, 1.0),
+    ]);
     let mut sim = EventEngine::new(&scene, &plan(BroadChoice::Auto), Direction::Forward).unwrap();
     let mut st = BallStates::default();
     for k in 1..=100 {
@@ -204,25 +191,12 @@ fn balls_at_a_million_metres_per_second_never_leave_the_box_or_pass_each_other()
 #[test]
 fn a_ball_starting_partly_outside_the_border_is_brought_back_not_lost() {
     // PhET lets such a ball escape for good. Overlap allowed by the contract: 1e-9 m.
-    let border = Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0)).unwrap();
-    let scene = Scene {
-        name: None,
-        world: World {
-            border: Some(BorderSpec {
-                border,
-                restitution: 1.0,
-                periodic: false,
-            }),
-            ..World::default()
-        },
-        balls: vec![BallSpec::new(
-            Vector2::new(0.9 + 5e-10, 0.0),
-            Vector2::new(2.0, 0.0),
-            0.1,
-            1.0,
-        )],
-        boxes: Vec::new(),
-    };
+    let scene = classic::elastic_box(vec![BallSpec::new(
+        Vector2::new(0.9 + 5e-10, 0.0),
+        Vector2::new(2.0, 0.0),
+        0.1,
+        1.0,
+    )]);
     let (st, log) = run(&scene, 0.5, BroadChoice::Auto);
     assert!(matches!(log[0], Collision::BallBorder { time, .. } if time == 0.0));
     assert!((st.vel[0].x + 2.0).abs() < 1e-15);

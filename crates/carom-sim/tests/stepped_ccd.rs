@@ -12,6 +12,7 @@ use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;
 use carom_math::{Real, Space};
 use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
+use carom_sim::scenes::classic;
 use carom_sim::scenes::gas::{GasParams, gas};
 use carom_sim::{Collision, Simulation};
 use common::{Recorder, states, stepped};
@@ -97,28 +98,17 @@ fn a_ball_trapped_between_a_box_and_a_wall_bounces_every_time_within_a_step() {
     // Border x ∈ [−1, 1]; a box whose left face is at x = 0.4; the ball (r = 0.1) runs
     // between x = −0.9 and x = 0.3 at 1e5 m/s: about 69 bounces per step of 1/600 s.
     let v = 1e5;
-    let s = Scene {
-        world: World {
-            border: Some(BorderSpec {
-                border: Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0)).unwrap(),
-                restitution: 1.0,
-                periodic: false,
-            }),
-            ..World::default()
-        },
-        balls: vec![BallSpec::new(
-            Vector2::new(0.0, 0.0),
-            Vector2::new(v, 0.0),
-            0.1,
-            1.0,
-        )],
-        boxes: vec![BoxSpec {
-            shape: Obb::from_angle(Vector2::new(0.45, 0.0), Vector2::new(0.05, 0.5), 0.0).unwrap(),
-            vel: Vector2::zeros(),
-            restitution: 1.0,
-        }],
-        ..Scene::default()
-    };
+    let mut s = classic::elastic_box(vec![BallSpec::new(
+        Vector2::new(0.0, 0.0),
+        Vector2::new(v, 0.0),
+        0.1,
+        1.0,
+    )]);
+    s.boxes.push(BoxSpec {
+        shape: Obb::from_angle(Vector2::new(0.45, 0.0), Vector2::new(0.05, 0.5), 0.0).unwrap(),
+        vel: Vector2::zeros(),
+        restitution: 1.0,
+    });
     let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
     let mut rec = Recorder::default();
     for k in 1..=10 {
@@ -200,28 +190,30 @@ fn a_ball_at_a_million_metres_per_second_stays_in_the_border_and_out_of_thin_box
     assert!(sim.counters().ball_box > 100 && sim.counters().ball_border > 100);
 }
 
+/// A table-tennis ball (radius 2 cm, 2.7 g) at rest at the origin and a paddle (a box of
+/// half extents 1 cm × 10 cm) centred at `center`, turned by `angle`, moving along `x` at
+/// `speed`, with restitution `e`.
+fn ball_and_paddle(center: Vector2<f64>, angle: f64, speed: f64, e: f64) -> Scene<f64, 2> {
+    Scene {
+        balls: vec![BallSpec::new(
+            Vector2::zeros(),
+            Vector2::zeros(),
+            0.02,
+            0.0027,
+        )],
+        boxes: vec![BoxSpec {
+            shape: Obb::from_angle(center, Vector2::new(0.01, 0.1), angle).unwrap(),
+            vel: Vector2::new(speed, 0.0),
+            restitution: e,
+        }],
+        ..Scene::default()
+    }
+}
+
 #[test]
 fn a_paddle_sends_a_ball_at_rest_off_at_one_plus_e_times_its_speed() {
     for (u, e) in [(3.0_f64, 1.0), (3.0, 0.6), (200.0, 0.85), (-50.0, 0.0)] {
-        let s = Scene {
-            balls: vec![BallSpec::new(
-                Vector2::zeros(),
-                Vector2::zeros(),
-                0.02,
-                0.0027,
-            )],
-            boxes: vec![BoxSpec {
-                shape: Obb::from_angle(
-                    Vector2::new(-0.5 * u.signum(), 0.0),
-                    Vector2::new(0.01, 0.1),
-                    0.0,
-                )
-                .unwrap(),
-                vel: Vector2::new(u, 0.0),
-                restitution: e,
-            }],
-            ..Scene::default()
-        };
+        let s = ball_and_paddle(Vector2::new(-0.5 * u.signum(), 0.0), 0.0, u, e);
         let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
         let mut rec = Recorder::default();
         sim.advance_to(1.0 / u.abs() + 2.0 * DT, &mut rec).unwrap();
@@ -244,20 +236,7 @@ fn a_paddle_sends_a_ball_at_rest_off_at_one_plus_e_times_its_speed() {
 #[test]
 fn a_paddle_driven_from_rust_hits_at_its_scripted_speed() {
     // The paddle waits, then is given 40 m/s for the steps it swings, then stops.
-    let s = Scene {
-        balls: vec![BallSpec::new(
-            Vector2::zeros(),
-            Vector2::zeros(),
-            0.02,
-            0.0027,
-        )],
-        boxes: vec![BoxSpec {
-            shape: Obb::from_angle(Vector2::new(-0.2, 0.0), Vector2::new(0.01, 0.1), 0.3).unwrap(),
-            vel: Vector2::zeros(),
-            restitution: 0.9,
-        }],
-        ..Scene::default()
-    };
+    let s = ball_and_paddle(Vector2::new(-0.2, 0.0), 0.3, 0.0, 0.9);
     let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
     let mut rec = Recorder::default();
     sim.advance_to(0.1, &mut rec).unwrap();

@@ -6,9 +6,8 @@
 //! fast balls travel far more than their size in a step; references are the closed forms
 //! of [`crate::reference`].
 
-use carom_geometry::Border;
 use carom_integrate::Integrator;
-use carom_sim::scene::{BallSpec, BorderSpec, Scene, World};
+use carom_sim::scene::{BallSpec, Scene, World};
 use carom_sim::scenes::classic;
 use carom_sim::{BallStates, Counters, observe};
 use nalgebra::Vector2;
@@ -215,30 +214,12 @@ fn mass_ratios() -> Vec<StabilityRow> {
         .collect()
 }
 
-/// A box `[-1, 1]²` with elastic walls.
-fn boxed(balls: Vec<BallSpec<f64, 2>>) -> Scene<f64, 2> {
-    Scene {
-        name: Some("box".to_owned()),
-        world: World {
-            border: Some(BorderSpec {
-                border: Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0))
-                    .expect("a valid box"),
-                restitution: 1.0,
-                periodic: false,
-            }),
-            ..World::default()
-        },
-        balls,
-        boxes: Vec::new(),
-    }
-}
-
 fn speeds() -> Vec<StabilityRow> {
     let speed = 1e6;
     // One step of 1/60 s: 16,667 m of flight, about 11,000 wall bounces in the step.
     let r = 0.1;
     let vel = Vector2::new(speed, 0.37 * speed);
-    let s = boxed(vec![BallSpec::new(Vector2::new(0.2, -0.3), vel, r, 1.0)]);
+    let s = classic::elastic_box(vec![BallSpec::new(Vector2::new(0.2, -0.3), vel, r, 1.0)]);
     let t = DT;
     let (x, vx) = reference::between_walls(0.2, vel.x, -1.0, 1.0, r, t);
     let (y, vy) = reference::between_walls(-0.3, vel.y, -1.0, 1.0, r, t);

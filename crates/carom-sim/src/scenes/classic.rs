@@ -23,6 +23,24 @@ pub fn head_on(m0: f64, m1: f64, v0: f64, v1: f64, e: f64) -> Scene<f64, 2> {
     }
 }
 
+/// `balls` in the box `[−1, 1]²` with elastic walls (restitution 1), no gravity.
+pub fn elastic_box(balls: Vec<BallSpec<f64, 2>>) -> Scene<f64, 2> {
+    Scene {
+        name: Some("box".to_owned()),
+        world: World {
+            border: Some(BorderSpec {
+                border: Border::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0))
+                    .expect("[-1, 1]² is a valid box"),
+                restitution: 1.0,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls,
+        boxes: Vec::new(),
+    }
+}
+
 /// Newton's cradle: `n` equal balls of radius 0.1 touching in a row on the x axis
 /// (centres 0.2 apart, starting at `x = 0`), and one more ball coming in from the left at
 /// speed `v`, 0.5 m away. With restitution 1 the textbook result is that the last ball
