@@ -174,6 +174,23 @@ pub fn between_walls(x0: f64, v: f64, lo: f64, hi: f64, r: f64, t: f64) -> (f64,
     }
 }
 
+/// Newton's cradle (`carom_sim::scenes::classic::newtons_cradle(n, 1.0)`: the striker
+/// 0.5 m left of a touching row of `n` balls, coming in at 1 m/s) at time `t >= 0.5`:
+/// the textbook answer for equal elastic balls. The striker stops touching the row (its
+/// centre at −0.2), the row stays at rest, and the last ball leaves at 1 m/s from the
+/// instant the striker arrives (0.5 s).
+pub fn newtons_cradle(n: usize, t: f64) -> Vec<Motion> {
+    let mut motions: Vec<Motion> = (0..=n)
+        .map(|k| Motion {
+            pos: Vector2::new(if k == 0 { -0.2 } else { 0.2 * (k - 1) as f64 }, 0.0),
+            vel: Vector2::zeros(),
+        })
+        .collect();
+    motions[n].pos.x += t - 0.5;
+    motions[n].vel.x = 1.0;
+    motions
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -185,6 +202,24 @@ mod tests {
             radius: 0.1,
             mass,
         }
+    }
+
+    #[test]
+    fn newtons_cradle_keeps_the_scene_layout_and_the_striker_momentum() {
+        let n = 4;
+        let scene = carom_sim::scenes::classic::newtons_cradle(n, 1.0);
+        let m = newtons_cradle(n, 2.0);
+        assert_eq!(m.len(), scene.balls.len());
+        // The row's resting balls stay where the scene puts them.
+        for (motion, ball) in m.iter().zip(&scene.balls).take(n).skip(1) {
+            assert_eq!(motion.pos, ball.pos);
+        }
+        // The striker's momentum ends in the last ball, which left 1.5 s ago.
+        let p: f64 = m.iter().map(|b| b.vel.x).sum();
+        assert_eq!(p, scene.balls[0].vel.x);
+        assert_eq!(m[n].pos.x, scene.balls[n].pos.x + 1.5);
+        // The striker stops touching the first ball of the row.
+        assert_eq!(m[1].pos.x - m[0].pos.x, 0.2);
     }
 
     #[test]

@@ -252,17 +252,7 @@ fn newtons_cradle_passes_the_whole_momentum_to_the_last_ball() {
         // The striker meets the row at 0.5 s; the textbook answer, at 2 s: the striker
         // at rest touching the row, the row at rest, the last ball 1.5 s away at 1 m/s.
         let t = 2.0;
-        let mut expected: Vec<reference::Motion> = s
-            .balls
-            .iter()
-            .map(|b| reference::Motion {
-                pos: b.pos,
-                vel: Vector2::zeros(),
-            })
-            .collect();
-        expected[0].pos.x = -0.2;
-        expected[n].pos.x += 1.5;
-        expected[n].vel.x = 1.0;
+        let expected = reference::newtons_cradle(n, t);
         let (_, rv) = rapier(&s, t);
         println!(
             "Newton's cradle, {n}: rapier2d's final x velocities {:?}",

@@ -333,17 +333,7 @@ fn touching_chain() -> Vec<StabilityRow> {
     let n = 10;
     let s = classic::newtons_cradle(n, 1.0);
     let t = 2.0;
-    let mut expected: Vec<Motion> = s
-        .balls
-        .iter()
-        .map(|b| Motion {
-            pos: b.pos,
-            vel: Vector2::zeros(),
-        })
-        .collect();
-    expected[0].pos.x = -0.2;
-    expected[n].pos.x += 1.5;
-    expected[n].vel.x = 1.0;
+    let expected = reference::newtons_cradle(n, t);
     compare_rows(
         "touching chain (Newton's cradle of 10)",
         &s,
