@@ -45,8 +45,10 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
-/// Distinct colours that read on white (Okabe–Ito, colour-blind safe).
-const PALETTE: [RGBColor; 8] = [
+/// Distinct colours that read on white, for every plot of the report: the Okabe–Ito
+/// palette (colour-blind safe) with black and grey (reference lines use black), then a
+/// purple, and Okabe–Ito's yellow last (it is faint on white).
+pub(crate) const PALETTE: [RGBColor; 10] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),
@@ -55,6 +57,8 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(230, 159, 0),
     RGBColor(0, 0, 0),
     RGBColor(150, 150, 150),
+    RGBColor(150, 60, 200),
+    RGBColor(240, 228, 66),
 ];
 
 /// `[lo, hi]` of `values`, widened to a visible range: by a factor on a log axis (which

@@ -12,6 +12,7 @@ use plotters::prelude::*;
 
 use super::PROBLEMS;
 use crate::model::WorkPrecisionRow;
+use crate::plot::PALETTE;
 
 /// Errors are drawn at this value or above.
 const FLOOR: f64 = 1e-16;
@@ -120,21 +121,6 @@ fn error_label(problem: &str) -> &'static str {
     }
 }
 
-/// Line colours: the Okabe–Ito palette (readable for colour-blind readers) without its
-/// yellow, then black, grey and that yellow last (it is faint on white).
-const COLOURS: [RGBColor; 10] = [
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
-    RGBColor(0, 158, 115),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 114, 178),
-    RGBColor(204, 121, 167),
-    RGBColor(0, 0, 0),
-    RGBColor(120, 120, 120),
-    RGBColor(150, 60, 200),
-    RGBColor(240, 228, 66),
-];
-
 /// Width of the legend panel right of the chart (pixels).
 const LEGEND_WIDTH: u32 = 280;
 
@@ -201,7 +187,7 @@ fn draw<DB: DrawingBackend>(
         font.clone(),
     ))?;
     for (k, method) in methods.iter().enumerate() {
-        let colour = COLOURS[k % COLOURS.len()];
+        let colour = PALETTE[k % PALETTE.len()];
         let mut of: Vec<&&WorkPrecisionRow> = rows.iter().filter(|r| r.method == *method).collect();
         // Along the steps, coarse to fine: the line follows the method's refinement.
         of.sort_by(|a, b| b.dt.unwrap_or(0.0).total_cmp(&a.dt.unwrap_or(0.0)));
