@@ -314,12 +314,7 @@ where
                 self.body(i, b.chord[i], b.seg_w[i]),
                 self.body(j, b.chord[j], b.seg_w[j]),
             );
-            let r = resolve(
-                &ci,
-                &cj,
-                &contact,
-                &Coefficients::new_unchecked(T::zero(), self.rules.friction),
-            );
+            let r = self.stop_closing(&ci, &cj, &contact);
             if r.applied() {
                 for (k, ball, body) in [(0, i, ci), (1, j, cj)] {
                     let du = r.velocity[k] - body.velocity();
@@ -371,12 +366,7 @@ where
             };
             let other = Body::kinematic(velocity, spin).unwrap_or_else(|_| Body::fixed());
             let ball = self.body(i, chord, b.seg_w[i]);
-            let r = resolve(
-                &ball,
-                &other,
-                &contact,
-                &Coefficients::new_unchecked(T::zero(), self.rules.friction),
-            );
+            let r = self.stop_closing(&ball, &other, &contact);
             if r.applied() {
                 let du = r.velocity[0] - ball.velocity();
                 let dw = r.angular_velocity[0] - ball.angular_velocity();
@@ -384,6 +374,23 @@ where
             }
         }
         self.balls.supported[i] = true;
+    }
+
+    /// The restitution-0 impulse, with the world's friction, between `a` and `b` at
+    /// `contact`: what stops two bodies closing along their chords (momentum kept,
+    /// energy never added).
+    pub(super) fn stop_closing(
+        &self,
+        a: &Body<T, D>,
+        b: &Body<T, D>,
+        contact: &Contact<T, D>,
+    ) -> Response<T, D> {
+        resolve(
+            a,
+            b,
+            contact,
+            &Coefficients::new_unchecked(T::zero(), self.rules.friction),
+        )
     }
 
     /// The approach speed of two dynamic bodies at `contact` and their collision with

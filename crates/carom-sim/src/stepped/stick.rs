@@ -30,7 +30,7 @@
 
 use carom_integrate::ForceField;
 use carom_math::{Real, Space, Vector};
-use carom_response::{Body, Coefficients, Contact, Response, RigidCluster, resolve};
+use carom_response::{Body, Contact, Response, RigidCluster};
 use nalgebra::Const;
 
 use super::clusters::{Clusters, FREE, StuckCluster};
@@ -193,12 +193,7 @@ where
         if (balls.chord[j] - balls.chord[i]).dot(&n) < T::zero() && s < self.h {
             // Still closing along the chords: a perfectly inelastic correction.
             let (ca, cb) = (self.chord_body(a, i), self.chord_body(b, j));
-            let r = resolve(
-                &ca,
-                &cb,
-                &contact,
-                &Coefficients::new_unchecked(T::zero(), self.rules.friction),
-            );
+            let r = self.stop_closing(&ca, &cb, &contact);
             if r.applied() {
                 self.apply(a, 0, &ca, &r, &contact, s);
                 self.apply(b, 1, &cb, &r, &contact, s);
