@@ -127,8 +127,8 @@ where
     }
 
     /// Makes the broad phase valid for a step of length `h` whose paths start at in-step
-    /// time 0: keeps the entries if every ball's path and every box's sweep still fits
-    /// (balls that do not fit become escapees, up to the bound, to be predicted by
+    /// time 0: keeps the entries if every box's sweep still fits and fewer than
+    /// `escape_bound` balls' paths do not (those become escapees, to be predicted by
     /// query), rebuilds them otherwise (no escapees).
     pub(crate) fn begin_step(
         &mut self,
@@ -167,16 +167,18 @@ where
                     collect(c, out);
                 }
             }
-            for &i in misfits[..chunks].iter().flatten().take(escape_bound) {
-                let i = i as usize;
-                let path = path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]);
-                self.escapees.set(i, path);
+            let count: usize = misfits[..chunks].iter().map(Vec::len).sum();
+            if count < escape_bound {
+                for &i in misfits[..chunks].iter().flatten() {
+                    let i = i as usize;
+                    let path = path_box(&balls.seg_x[i], &balls.pos[i], balls.radius[i]);
+                    self.escapees.set(i, path);
+                }
             }
             self.misfits = misfits;
-            if self.escapees.len() < escape_bound {
+            if count < escape_bound {
                 return;
             }
-            self.escapees.clear();
         }
         let steps = self.reach_steps(balls, h, parallel);
         self.build(balls, boxes, T::zero(), h * T::from_count(steps), parallel);
