@@ -45,7 +45,7 @@ use carom_math::{Real, Vector};
 
 use crate::pairs::{Emitter, PairBuffers};
 use crate::par::{fill_indexed, fold_indexed, try_map_in_place};
-use crate::radix::{entry, entry_id, entry_key, insertion_sort_bounded, radix_sort_by_key};
+use crate::radix::{entry, entry_id, entry_key, insertion_sort_bounded, sort_by_key};
 use crate::sweep::{SortPolicy, SweepCore};
 use crate::volumes::{Proxy, Store, ensure_ratio, overlap, sampled_median};
 use crate::{BroadPhase, Pair, Volumes};
@@ -876,7 +876,12 @@ impl<T: Real, const D: usize> UniformGrid<T, D> {
             fill_indexed(&mut self.keys, regular, parallel, |x| {
                 entry(bucket_of[ids[x] as usize], ids[x])
             });
-            radix_sort_by_key(&mut self.keys, &mut self.scratch, &mut self.counts);
+            sort_by_key(
+                &mut self.keys,
+                &mut self.scratch,
+                &mut self.counts,
+                parallel,
+            );
         }
         fill_starts(&mut self.start, g.buckets, &self.keys, parallel);
         let (keys, store) = (&self.keys, &self.store);

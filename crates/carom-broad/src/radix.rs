@@ -11,6 +11,11 @@
 //! A sort entry is `key << 32 | index`, so sorting entries orders by key and breaks ties
 //! by index: the sorted order is a function of the current keys alone, not of the
 //! previous frame's order, which keeps the incremental path deterministic.
+//!
+//! On the rayon pool, long inputs are first split by their leading key bits into
+//! partitions (a parallel histogram and a stable parallel scatter), then each partition
+//! is radix-sorted on its remaining bits as its own task. Every pass is stable, so the
+//! result is the sequential sort's, bit for bit, on any number of threads.
 
 /// The order-preserving integer image of an `f32` (for non-NaN input).
 #[inline]
@@ -103,6 +108,141 @@ pub(crate) fn radix_sort_by_key(
             *slot += 1;
         }
         core::mem::swap(entries, scratch);
+    }
+}
+
+/// Below this many entries the parallel sort stays on the calling thread.
+#[cfg(feature = "parallel")]
+const PARALLEL_MIN: usize = 1 << 15;
+
+/// The parallel sort's partitions: the top `PARTITION_BITS` of the used key bits.
+#[cfg(feature = "parallel")]
+const PARTITION_BITS: u32 = 6;
+#[cfg(feature = "parallel")]
+const PARTITIONS: usize = 1 << PARTITION_BITS;
+
+/// [`radix_sort_by_key`], on the rayon pool when `parallel` and the input is long; the
+/// result is the same.
+#[cfg_attr(not(feature = "parallel"), allow(unused_variables))]
+pub(crate) fn sort_by_key(
+    entries: &mut Vec<u64>,
+    scratch: &mut Vec<u64>,
+    counts: &mut Vec<usize>,
+    parallel: bool,
+) {
+    #[cfg(feature = "parallel")]
+    if parallel && entries.len() >= PARALLEL_MIN && rayon::current_num_threads() > 1 {
+        par_radix_sort_by_key(entries, scratch);
+        return;
+    }
+    radix_sort_by_key(entries, scratch, counts);
+}
+
+/// The parallel sort (see the [module documentation](self)): an MSD split into
+/// [`PARTITIONS`] by the leading used key bits, then an LSD sort of each partition.
+#[cfg(feature = "parallel")]
+fn par_radix_sort_by_key(entries: &mut [u64], scratch: &mut Vec<u64>) {
+    use rayon::prelude::*;
+    let n = entries.len();
+    let top = entries.par_iter().map(|&e| entry_key(e)).max().unwrap_or(0);
+    // The keys below `shift` are sorted within a partition; the bits above pick it.
+    let used = u32::BITS - top.leading_zeros();
+    let shift = used.saturating_sub(PARTITION_BITS);
+    let part = |e: u64| (entry_key(e) >> shift) as usize;
+
+    // Per-chunk histograms, then each (partition, chunk) gets its slot in `scratch`:
+    // partitions in order, and within one the chunks in order, so the scatter is stable.
+    let len = n.div_ceil(crate::parallel_chunks());
+    let histograms: Vec<[usize; PARTITIONS]> = entries
+        .par_chunks(len)
+        .map(|chunk| {
+            let mut h = [0; PARTITIONS];
+            for &e in chunk {
+                h[part(e)] += 1;
+            }
+            h
+        })
+        .collect();
+    scratch.clear();
+    scratch.resize(n, 0);
+    let mut slots: Vec<Vec<&mut [u64]>> = histograms
+        .iter()
+        .map(|_| Vec::with_capacity(PARTITIONS))
+        .collect();
+    let mut partition_len = [0; PARTITIONS];
+    let mut rest = scratch.as_mut_slice();
+    for (p, size) in partition_len.iter_mut().enumerate() {
+        for (h, chunk_slots) in histograms.iter().zip(&mut slots) {
+            let (slot, tail) = core::mem::take(&mut rest).split_at_mut(h[p]);
+            chunk_slots.push(slot);
+            rest = tail;
+            *size += h[p];
+        }
+    }
+    entries
+        .par_chunks(len)
+        .zip(slots.into_par_iter())
+        .for_each(|(chunk, mut out)| {
+            let mut next = [0; PARTITIONS];
+            for &e in chunk {
+                let p = part(e);
+                out[p][next[p]] = e;
+                next[p] += 1;
+            }
+        });
+
+    // Each partition sorted on its low `shift` key bits, the result back in `entries`.
+    let mut pieces = Vec::with_capacity(PARTITIONS);
+    let (mut from, mut to) = (scratch.as_mut_slice(), entries);
+    for size in partition_len {
+        let (a, rest_from) = core::mem::take(&mut from).split_at_mut(size);
+        let (b, rest_to) = core::mem::take(&mut to).split_at_mut(size);
+        pieces.push((a, b));
+        (from, to) = (rest_from, rest_to);
+    }
+    pieces
+        .into_par_iter()
+        .with_max_len(1)
+        .for_each(|(part, out)| sort_low_bits(part, out, shift));
+}
+
+/// Stable LSD sort of `part` by the key bits below `bits` (11 at a time, a pass whose
+/// digits are all equal skipped); the sorted entries end in `out`, `part` is scratch.
+#[cfg(feature = "parallel")]
+fn sort_low_bits(part: &mut [u64], out: &mut [u64], bits: u32) {
+    if part.len() < 256 {
+        // Fewer entries than buckets: a stable comparison sort by key is cheaper.
+        part.sort_by_key(|&e| entry_key(e));
+        out.copy_from_slice(part);
+        return;
+    }
+    let (mut src, mut dst) = (part, out);
+    let mut in_out = false;
+    let mut counts = [0usize; BUCKETS];
+    for shift in (0..bits).step_by(RADIX_BITS as usize) {
+        let digit = |e: u64| ((e >> (32 + shift)) as usize) & (BUCKETS - 1);
+        counts.fill(0);
+        for &e in src.iter() {
+            counts[digit(e)] += 1;
+        }
+        if counts.contains(&src.len()) {
+            continue;
+        }
+        let mut sum = 0;
+        for c in &mut counts {
+            (*c, sum) = (sum, sum + *c);
+        }
+        for &e in src.iter() {
+            let slot = &mut counts[digit(e)];
+            dst[*slot] = e;
+            *slot += 1;
+        }
+        core::mem::swap(&mut src, &mut dst);
+        in_out = !in_out;
+    }
+    if !in_out {
+        // The last pass wrote `src` (or none ran): copy into `out`, which is `dst` now.
+        dst.copy_from_slice(src);
     }
 }
 
@@ -203,6 +343,55 @@ mod tests {
             let same = |a: u32, b: u32| a == b || (zero(a) && zero(b));
             assert!(same(key_down(x), down), "key_down({x:e})");
             assert!(same(key_up(x), up), "key_up({x:e})");
+        }
+    }
+
+    /// The parallel sort equals the sequential radix sort (a stable sort by key) on any
+    /// pool, for keys spanning a few values, a narrow range (one partition per key
+    /// group), a grid-like range and the whole of `u32`, with the indices in order and
+    /// shuffled (stability, not the index tie-break, is what both sorts share).
+    #[cfg(feature = "parallel")]
+    #[test]
+    fn the_parallel_sort_is_the_sequential_one_on_any_pool() {
+        let mut state = 777u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 32) as u32
+        };
+        for (n, range) in [
+            (PARALLEL_MIN, 1u32),
+            (PARALLEL_MIN + 5, 40),
+            (70_000, 5_000),
+            (120_000, 400_000),
+            (50_000, u32::MAX),
+        ] {
+            let keys: Vec<u32> = (0..n).map(|_| next() % range.max(1)).collect();
+            let in_order: Vec<u64> = (0..n as u32).map(|i| entry(keys[i as usize], i)).collect();
+            let shuffled: Vec<u64> = (0..n as u32)
+                .map(|i| entry(keys[i as usize], next()))
+                .collect();
+            for input in [in_order, shuffled] {
+                let mut expected = input.clone();
+                expected.sort_by_key(|&e| entry_key(e));
+                let (mut scratch, mut counts) = (Vec::new(), Vec::new());
+                let mut sequential = input.clone();
+                sort_by_key(&mut sequential, &mut scratch, &mut counts, false);
+                assert_eq!(sequential, expected, "sequential, n = {n}, range {range}");
+                for threads in [1, 2, 3] {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .expect("a pool");
+                    let mut sorted = input.clone();
+                    pool.install(|| sort_by_key(&mut sorted, &mut scratch, &mut counts, true));
+                    assert_eq!(
+                        sorted, expected,
+                        "{threads} threads, n = {n}, range {range}"
+                    );
+                }
+            }
         }
     }
 

@@ -36,7 +36,7 @@ use carom_math::{Real, Vector};
 use crate::pairs::{Emitter, PairBuffers};
 use crate::par::{fill_indexed, map_in_place, max_indexed};
 use crate::radix::{
-    entry, entry_id, entry_key, insertion_sort_bounded, key_down, key_up, radix_sort_by_key,
+    entry, entry_id, entry_key, insertion_sort_bounded, key_down, key_up, sort_by_key,
 };
 use crate::volumes::{Proxy, Store, overlap};
 use crate::{BroadPhase, Pair, Volumes};
@@ -171,7 +171,12 @@ impl<T: Real, const D: usize> SweepCore<T, D> {
                 fill_indexed(&mut self.entries, n, parallel, |k| {
                     entry(key_of(id_at(k)), id_at(k))
                 });
-                radix_sort_by_key(&mut self.entries, &mut self.scratch, &mut self.counts);
+                sort_by_key(
+                    &mut self.entries,
+                    &mut self.scratch,
+                    &mut self.counts,
+                    parallel,
+                );
                 self.last_sort = SortKind::Radix;
             }
         } else {
