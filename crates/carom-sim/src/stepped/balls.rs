@@ -123,6 +123,18 @@ where
         self.radius.len()
     }
 
+    /// Reads every field of ball `i` so that its row is in the cache before it is
+    /// needed (`black_box` keeps the reads; nothing is computed).
+    pub(crate) fn load_row(&self, i: usize) {
+        std::hint::black_box((
+            (self.radius[i], self.mass[i], self.inverse_mass[i]),
+            (self.inverse_inertia[i], self.restitution[i], self.pos[i]),
+            (self.vel[i], self.spin[i], self.seg_t[i], self.seg_x[i]),
+            (self.seg_v[i], self.seg_w[i], self.chord[i], self.version[i]),
+            (self.supported[i], self.cluster[i]),
+        ));
+    }
+
     /// Position of ball `i` at in-step time `s` on its segment.
     #[inline]
     pub(crate) fn position_at(&self, i: usize, s: T) -> Vector<T, D> {

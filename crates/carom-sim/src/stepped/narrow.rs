@@ -89,6 +89,24 @@ impl<T: Real, const D: usize> Event<T, D> {
     }
 }
 
+#[cfg(test)]
+impl<T: Real, const D: usize> Event<T, D> {
+    /// A contact of balls `ball < other` at in-step time `time`, without gravity, with a
+    /// simultaneity window `window` (for tests of the queue order).
+    pub(crate) fn between(ball: u32, other: u32, time: T, window: T) -> Self {
+        Self {
+            instant: (time / window).floor().to_f64() as u64,
+            height: T::zero(),
+            time,
+            ball,
+            target: Target::Ball(other),
+            versions: [0, 0],
+            normal: Vector::zeros(),
+            shift: Vector::zeros(),
+        }
+    }
+}
+
 /// A min-queue entry.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Pending<T: Real, const D: usize>(pub(crate) Event<T, D>);

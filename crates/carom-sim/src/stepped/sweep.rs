@@ -295,6 +295,25 @@ where
         self.partner_start = next;
     }
 
+    /// Reads ball `i`'s entry, partner list and the fields a prediction reads of each
+    /// partner, so that they are in the cache before `candidates` and the times of
+    /// impact need them (`black_box` keeps the reads; nothing is computed).
+    pub(crate) fn load_partners(&self, i: usize, balls: &BallArrays<T, D>) {
+        let partners = &self.partners[self.partner_start[i]..self.partner_start[i + 1]];
+        std::hint::black_box((&self.volumes[i], self.escapees.box_of(i).is_some()));
+        for &p in partners.iter().filter(|&&p| (p as usize) < self.balls) {
+            let p = p as usize;
+            std::hint::black_box((
+                balls.seg_x[p],
+                balls.chord[p],
+                balls.seg_t[p],
+                balls.radius[p],
+                balls.version[p],
+                balls.cluster[p],
+            ));
+        }
+    }
+
     /// Whether `path` (a ball's remaining path box) lies in ball `i`'s entry.
     fn holds(&self, i: usize, path: &Aabb<T, D>) -> bool {
         contains(self.box_of(i), path)
