@@ -23,6 +23,7 @@ use carom_math::{Real, Space, Vector};
 use nalgebra::Const;
 
 use super::clusters::FREE;
+use super::prefetch::prefetch;
 use crate::engine::Angular;
 use crate::scene::{Scene, SceneError};
 
@@ -123,16 +124,24 @@ where
         self.radius.len()
     }
 
-    /// Reads every field of ball `i` so that its row is in the cache before it is
-    /// needed (`black_box` keeps the reads; nothing is computed).
-    pub(crate) fn load_row(&self, i: usize) {
-        std::hint::black_box((
-            (self.radius[i], self.mass[i], self.inverse_mass[i]),
-            (self.inverse_inertia[i], self.restitution[i], self.pos[i]),
-            (self.vel[i], self.spin[i], self.seg_t[i], self.seg_x[i]),
-            (self.seg_v[i], self.seg_w[i], self.chord[i], self.version[i]),
-            (self.supported[i], self.cluster[i]),
-        ));
+    /// Prefetches every field of ball `i` (see `prefetch`).
+    pub(crate) fn prefetch_row(&self, i: usize) {
+        prefetch(&self.radius[i]);
+        prefetch(&self.mass[i]);
+        prefetch(&self.inverse_mass[i]);
+        prefetch(&self.inverse_inertia[i]);
+        prefetch(&self.restitution[i]);
+        prefetch(&self.pos[i]);
+        prefetch(&self.vel[i]);
+        prefetch(&self.spin[i]);
+        prefetch(&self.seg_t[i]);
+        prefetch(&self.seg_x[i]);
+        prefetch(&self.seg_v[i]);
+        prefetch(&self.seg_w[i]);
+        prefetch(&self.chord[i]);
+        prefetch(&self.version[i]);
+        prefetch(&self.supported[i]);
+        prefetch(&self.cluster[i]);
     }
 
     /// Position of ball `i` at in-step time `s` on its segment.

@@ -16,6 +16,7 @@
 use carom_geometry::Aabb;
 use carom_math::Real;
 
+use super::prefetch::prefetch;
 use super::sweep::overlap;
 
 /// The most lanes a box is filed in; wider boxes go to the wide list.
@@ -107,6 +108,11 @@ impl<T: Real, const D: usize> Escapees<T, D> {
             NOT_ESCAPED => None,
             k => Some(&self.boxes[k as usize]),
         }
+    }
+
+    /// Prefetches ball `i`'s slot (see `prefetch`).
+    pub(crate) fn prefetch(&self, i: usize) {
+        prefetch(&self.index[i]);
     }
 
     /// Makes ball `i` an escapee (or keeps it one) with the box `path`.

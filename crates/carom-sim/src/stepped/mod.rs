@@ -46,6 +46,7 @@ mod escapees;
 mod forces;
 mod narrow;
 mod obstacles;
+mod prefetch;
 mod queue;
 mod response;
 mod rest;
@@ -68,10 +69,6 @@ use self::queue::EventQueue;
 use self::response::{Contacts, Effect, RestSets, Rules, Surface};
 use self::rest::{Support, Touch};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
-
-/// How many contacts ahead of the one being answered the event loop loads rows (see
-/// `queue`).
-const LOOKAHEAD: usize = 2;
 
 /// Escapees per parallel task of the step's first predictions (each is a broad-phase
 /// query and a few times of impact: 1.4 µs on average, timed on a 1e5-ball gas).
@@ -574,18 +571,33 @@ where
         result
     }
 
-    /// Loads what answering `e` will read (its balls' rows, their entries and partner
-    /// lists, the partners' rows) into the cache, while the contacts before it are
-    /// answered (see `queue`). A hint: nothing is computed or changed.
-    fn load_ahead(&self, e: &Event<T, D>) {
-        let i = e.ball as usize;
-        let j = match e.target {
-            Target::Ball(j) => j as usize,
-            Target::Border | Target::Box(_) => i,
+    /// Prefetches what answering the next contacts will read, in three stages so that
+    /// each stage's reads hit the lines the one before fetched: three contacts ahead
+    /// their balls' rows, entries and partner-list starts; two ahead the partner lists;
+    /// one ahead the partners' rows (see `queue` and `prefetch`). A hint only.
+    fn prefetch_ahead(&self) {
+        let balls = |e: &Event<T, D>| {
+            let i = e.ball as usize;
+            match e.target {
+                Target::Ball(j) => [i, j as usize],
+                Target::Border | Target::Box(_) => [i, i],
+            }
         };
-        for ball in [i, j] {
-            self.balls.load_row(ball);
-            self.sweep.load_partners(ball, &self.balls);
+        if let Some(e) = self.queue.ahead(2) {
+            for ball in balls(e) {
+                self.balls.prefetch_row(ball);
+                self.sweep.prefetch_entry(ball);
+            }
+        }
+        if let Some(e) = self.queue.ahead(1) {
+            for ball in balls(e) {
+                self.sweep.prefetch_partner_list(ball);
+            }
+        }
+        if let Some(e) = self.queue.ahead(0) {
+            for ball in balls(e) {
+                self.sweep.prefetch_partner_rows(ball, &self.balls);
+            }
         }
     }
 
@@ -807,9 +819,7 @@ where
         observer: &mut dyn Observer<T>,
     ) -> Result<WindowEnd<T>, SimError> {
         while let Some(e) = self.queue.pop() {
-            if let Some(ahead) = self.queue.ahead(LOOKAHEAD) {
-                self.load_ahead(ahead);
-            }
+            self.prefetch_ahead();
             if !self.current(&e) {
                 continue;
             }

@@ -38,6 +38,7 @@ use rayon::prelude::*;
 use super::balls::BallArrays;
 use super::escapees::Escapees;
 use super::obstacles::BoxArrays;
+use super::prefetch::prefetch;
 use crate::plan::BroadChoice;
 
 /// Balls per parallel chunk of the data-parallel passes.
@@ -295,22 +296,34 @@ where
         self.partner_start = next;
     }
 
-    /// Reads ball `i`'s entry, partner list and the fields a prediction reads of each
-    /// partner, so that they are in the cache before `candidates` and the times of
-    /// impact need them (`black_box` keeps the reads; nothing is computed).
-    pub(crate) fn load_partners(&self, i: usize, balls: &BallArrays<T, D>) {
+    /// Prefetches what `candidates` first reads for ball `i`: its entry, its escapee
+    /// slot and where its partner list starts (see `prefetch`).
+    pub(crate) fn prefetch_entry(&self, i: usize) {
+        prefetch(&self.volumes[i]);
+        prefetch(&self.partner_start[i]);
+        self.escapees.prefetch(i);
+    }
+
+    /// Prefetches ball `i`'s partner list (its start should be cached by now).
+    pub(crate) fn prefetch_partner_list(&self, i: usize) {
+        // One prefetch per cache line of 16 partners.
+        for k in (self.partner_start[i]..self.partner_start[i + 1]).step_by(16) {
+            prefetch(&self.partners[k]);
+        }
+    }
+
+    /// Prefetches the fields a prediction reads of each of ball `i`'s partners (its list
+    /// should be cached by now).
+    pub(crate) fn prefetch_partner_rows(&self, i: usize, balls: &BallArrays<T, D>) {
         let partners = &self.partners[self.partner_start[i]..self.partner_start[i + 1]];
-        std::hint::black_box((&self.volumes[i], self.escapees.box_of(i).is_some()));
         for &p in partners.iter().filter(|&&p| (p as usize) < self.balls) {
             let p = p as usize;
-            std::hint::black_box((
-                balls.seg_x[p],
-                balls.chord[p],
-                balls.seg_t[p],
-                balls.radius[p],
-                balls.version[p],
-                balls.cluster[p],
-            ));
+            prefetch(&balls.seg_x[p]);
+            prefetch(&balls.chord[p]);
+            prefetch(&balls.seg_t[p]);
+            prefetch(&balls.radius[p]);
+            prefetch(&balls.version[p]);
+            prefetch(&balls.cluster[p]);
         }
     }
 
