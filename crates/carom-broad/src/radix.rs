@@ -86,29 +86,45 @@ pub(crate) fn radix_sort_by_key(
     scratch.resize(entries.len(), 0);
     counts.clear();
     counts.resize(BUCKETS, 0);
-    for pass in 0..3u32 {
-        let shift = 32 + pass * RADIX_BITS;
-        let digit = |e: u64| ((e >> shift) as usize) & (BUCKETS - 1);
+    let shifts = (0..3).map(|pass| pass * RADIX_BITS);
+    if radix_passes(entries, scratch, counts, shifts) {
+        core::mem::swap(entries, scratch);
+    }
+}
+
+/// Stable LSD passes over `src` by the 11-bit key digits starting at the bits `shifts`
+/// (a pass whose digits are all equal is skipped), each from one buffer into the other;
+/// `true` if the sorted entries ended in `dst`. `counts` has [`BUCKETS`] entries.
+fn radix_passes(
+    src: &mut [u64],
+    dst: &mut [u64],
+    counts: &mut [usize],
+    shifts: impl Iterator<Item = u32>,
+) -> bool {
+    let (mut src, mut dst) = (src, dst);
+    let mut in_dst = false;
+    for shift in shifts {
+        let digit = |e: u64| ((e >> (32 + shift)) as usize) & (BUCKETS - 1);
         counts.fill(0);
-        for &e in entries.iter() {
+        for &e in src.iter() {
             counts[digit(e)] += 1;
         }
-        if counts.contains(&entries.len()) {
+        if counts.contains(&src.len()) {
             continue;
         }
         let mut sum = 0;
         for c in counts.iter_mut() {
-            let here = *c;
-            *c = sum;
-            sum += here;
+            (*c, sum) = (sum, sum + *c);
         }
-        for &e in entries.iter() {
+        for &e in src.iter() {
             let slot = &mut counts[digit(e)];
-            scratch[*slot] = e;
+            dst[*slot] = e;
             *slot += 1;
         }
-        core::mem::swap(entries, scratch);
+        core::mem::swap(&mut src, &mut dst);
+        in_dst = !in_dst;
     }
+    in_dst
 }
 
 /// Below this many entries the parallel sort stays on the calling thread.
@@ -216,33 +232,11 @@ fn sort_low_bits(part: &mut [u64], out: &mut [u64], bits: u32) {
         out.copy_from_slice(part);
         return;
     }
-    let (mut src, mut dst) = (part, out);
-    let mut in_out = false;
     let mut counts = [0usize; BUCKETS];
-    for shift in (0..bits).step_by(RADIX_BITS as usize) {
-        let digit = |e: u64| ((e >> (32 + shift)) as usize) & (BUCKETS - 1);
-        counts.fill(0);
-        for &e in src.iter() {
-            counts[digit(e)] += 1;
-        }
-        if counts.contains(&src.len()) {
-            continue;
-        }
-        let mut sum = 0;
-        for c in &mut counts {
-            (*c, sum) = (sum, sum + *c);
-        }
-        for &e in src.iter() {
-            let slot = &mut counts[digit(e)];
-            dst[*slot] = e;
-            *slot += 1;
-        }
-        core::mem::swap(&mut src, &mut dst);
-        in_out = !in_out;
-    }
-    if !in_out {
-        // The last pass wrote `src` (or none ran): copy into `out`, which is `dst` now.
-        dst.copy_from_slice(src);
+    let shifts = (0..bits).step_by(RADIX_BITS as usize);
+    if !radix_passes(part, out, &mut counts, shifts) {
+        // The last pass wrote `part` (or none ran).
+        out.copy_from_slice(part);
     }
 }
 
