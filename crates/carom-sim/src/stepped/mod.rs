@@ -576,26 +576,19 @@ where
     /// their balls' rows, entries and partner-list starts; two ahead the partner lists;
     /// one ahead the partners' rows (see `queue` and `prefetch`). A hint only.
     fn prefetch_ahead(&self) {
-        let balls = |e: &Event<T, D>| {
-            let i = e.ball as usize;
-            match e.target {
-                Target::Ball(j) => [i, j as usize],
-                Target::Border | Target::Box(_) => [i, i],
-            }
-        };
         if let Some(e) = self.queue.ahead(2) {
-            for ball in balls(e) {
+            for ball in e.balls() {
                 self.balls.prefetch_row(ball);
                 self.sweep.prefetch_entry(ball);
             }
         }
         if let Some(e) = self.queue.ahead(1) {
-            for ball in balls(e) {
+            for ball in e.balls() {
                 self.sweep.prefetch_partner_list(ball);
             }
         }
         if let Some(e) = self.queue.ahead(0) {
-            for ball in balls(e) {
+            for ball in e.balls() {
                 self.sweep.prefetch_partner_rows(ball, &self.balls);
             }
         }
@@ -617,11 +610,7 @@ where
     /// # Errors
     /// A fusion of two clusters that overflows the precision.
     fn process(&mut self, e: &Event<T, D>, h: T, t0: T) -> Result<Option<Collision<T>>, SimError> {
-        let i = e.ball as usize;
-        let other = match e.target {
-            Target::Ball(j) => j as usize,
-            Target::Border | Target::Box(_) => i,
-        };
+        let [i, other] = e.balls();
         let mut touches = core::mem::take(&mut self.touches);
         for (ball, out) in [i, other].into_iter().zip(touches.iter_mut()) {
             out.clear();

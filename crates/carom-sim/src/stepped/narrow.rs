@@ -89,10 +89,20 @@ impl<T: Real, const D: usize> Event<T, D> {
     }
 }
 
-#[cfg(test)]
 impl<T: Real, const D: usize> Event<T, D> {
+    /// The balls the contact involves: the ball and the other ball, or the ball twice
+    /// for a wall or a box.
+    pub(crate) fn balls(&self) -> [usize; 2] {
+        let i = self.ball as usize;
+        match self.target {
+            Target::Ball(j) => [i, j as usize],
+            Target::Border | Target::Box(_) => [i, i],
+        }
+    }
+
     /// A contact of balls `ball < other` at in-step time `time`, without gravity, with a
     /// simultaneity window `window` (for tests of the queue order).
+    #[cfg(test)]
     pub(crate) fn between(ball: u32, other: u32, time: T, window: T) -> Self {
         Self {
             instant: (time / window).floor().to_f64() as u64,
