@@ -264,6 +264,7 @@ pub(crate) fn insertion_sort_bounded(entries: &mut [u64], budget: usize) -> bool
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scenes::SplitMix64;
 
     #[test]
     fn keys_preserve_order_and_round_outward() {
@@ -319,11 +320,9 @@ mod tests {
             f64::INFINITY,
             f64::NEG_INFINITY,
         ];
-        let mut state = 99u64;
+        let mut rng = SplitMix64::new(99);
         for _ in 0..20_000 {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            let state = rng.next_u64();
             let x = f64::from_bits(state);
             if !x.is_nan() {
                 xs.push(x);
@@ -347,13 +346,8 @@ mod tests {
     #[cfg(feature = "parallel")]
     #[test]
     fn the_parallel_sort_is_the_sequential_one_on_any_pool() {
-        let mut state = 777u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 32) as u32
-        };
+        let mut rng = SplitMix64::new(777);
+        let mut next = || (rng.next_u64() >> 32) as u32;
         for (n, range) in [
             (PARALLEL_MIN, 1u32),
             (PARALLEL_MIN + 5, 40),
@@ -391,13 +385,8 @@ mod tests {
 
     #[test]
     fn radix_and_insertion_sorts_agree_with_the_standard_sort() {
-        let mut state = 12345u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) as u32
-        };
+        let mut rng = SplitMix64::new(12345);
+        let mut next = || (rng.next_u64() >> 32) as u32;
         let mut entries: Vec<u64> = (0..5000).map(|i| entry(next() % 700, i)).collect();
         let mut expected = entries.clone();
         expected.sort_unstable();
