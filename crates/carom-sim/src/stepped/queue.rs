@@ -7,9 +7,8 @@
 //! the window runs go to a binary heap, and each pop takes the earlier of the two heads.
 //! Both follow the total order of `Event::key_cmp`, so the sequence is the one a
 //! single heap would give. Being sorted, the first predictions can be read ahead
-//! ([`EventQueue::ahead`]): the event loop loads the rows of the contact a few places
-//! ahead while it answers the current one, which hides most of the cache misses of
-//! those rows (see `docs/stepped.md`).
+//! ([`EventQueue::ahead`]): the event loop prefetches what the next three contacts will
+//! read while it answers the current one (`prefetch`; measured in `docs/stepped.md`).
 
 use std::collections::BinaryHeap;
 
