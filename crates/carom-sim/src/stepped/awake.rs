@@ -4,8 +4,9 @@
 //! A rayon worker that finds no work spins for a few dozen rounds and then sleeps; the
 //! next parallel region has to wake it, and on this project's 2-core VM the wake-up
 //! costs tens of microseconds, during which the calling thread does the region's work
-//! alone. The step's in-step event loop (0.55 of the 1.93 ms of a 2-thread step at 1e5 balls, timed before the prefetch)
-//! is long enough for the other thread to fall asleep every step. [`hold_pool`] runs such
+//! alone. The step's in-step event loop (0.55 of the 1.93 ms of a 2-thread step at 1e5
+//! balls, timed before the prefetch) is long enough for the other thread to fall asleep
+//! every step. [`hold_pool`] runs such
 //! a section on the calling thread while one task per other thread waits for it to end,
 //! yielding its core to the OS scheduler on every round (so a busy machine loses nothing
 //! to the wait) but never sleeping. On the 1e5-ball gas of `docs/stepped.md` this took
