@@ -82,6 +82,85 @@ struct Load<T: Real, const D: usize> {
     under: Vec<(usize, Vector<T, D>, T)>,
 }
 
+/// The change of a rigid body's velocities during a projected Gauss–Seidel solve.
+struct Delta<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    inverse_mass: T,
+    inverse_inertia: <Const<D> as Space<T, D>>::Inertia,
+    /// Of the centre of mass.
+    dv: Vector<T, D>,
+    dw: Angular<T, D>,
+}
+
+impl<T: Real, const D: usize> Delta<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    fn new(rigid: &RigidCluster<T, D>) -> Self {
+        Self {
+            inverse_mass: T::one() / rigid.mass(),
+            inverse_inertia: rigid.world_inverse_inertia(),
+            dv: Vector::zeros(),
+            dw: <Const<D> as Space<T, D>>::angular_zero(),
+        }
+    }
+
+    /// Applies the impulse `p` at arm `a` (from the centre of mass).
+    fn push(&mut self, p: &Vector<T, D>, a: &Vector<T, D>) {
+        self.dv += p * self.inverse_mass;
+        self.dw += <Const<D> as Space<T, D>>::inertia_apply(
+            &self.inverse_inertia,
+            &<Const<D> as Space<T, D>>::cross(a, p),
+        );
+    }
+
+    /// The change of the velocity of the point at arm `a`.
+    fn at(&self, a: &Vector<T, D>) -> Vector<T, D> {
+        self.dv + <Const<D> as Space<T, D>>::angular_cross(&self.dw, a)
+    }
+
+    /// Friction at arm `a` (normal `n`, relative velocity `u`): the accumulated
+    /// tangential impulse `total` stops the slip, within the cone `|F_t| <= bound`; returns
+    /// the velocity change it made.
+    fn friction(
+        &mut self,
+        total: &mut Vector<T, D>,
+        u: &Vector<T, D>,
+        n: &Vector<T, D>,
+        a: &Vector<T, D>,
+        bound: T,
+    ) -> T {
+        let slip = u - n * u.dot(n);
+        let speed = slip.norm();
+        if speed <= T::zero() {
+            return T::zero();
+        }
+        let t = slip / speed;
+        let wanted = *total - t * (speed / self.stiffness(a, &t));
+        let clamped = if wanted.norm() > bound {
+            wanted * (bound / wanted.norm())
+        } else {
+            wanted
+        };
+        let change = clamped - *total;
+        *total = clamped;
+        self.push(&change, a);
+        change.norm() * self.stiffness(a, &t)
+    }
+
+    /// The inverse effective mass at arm `a` along unit `d`.
+    fn stiffness(&self, a: &Vector<T, D>, d: &Vector<T, D>) -> T {
+        let ad = <Const<D> as Space<T, D>>::cross(a, d);
+        self.inverse_mass
+            + <Const<D> as Space<T, D>>::angular_dot(
+                &ad,
+                &<Const<D> as Space<T, D>>::inertia_apply(&self.inverse_inertia, &ad),
+            )
+    }
+}
+
 /// One side of a contact: a free ball or a cluster.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Side {
@@ -339,26 +418,7 @@ where
         };
         let h = self.h;
         let rest = h - s;
-        // The members the ball rests on: `(member, normal from the ball into it, gap)`.
-        let mut under = vec![(member, *n, T::zero())];
-        {
-            let b = &*self.balls;
-            let (x, r) = (b.seg_x[q], b.radius[q]);
-            let tolerance = T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (x.amax() + r);
-            for &m in &self.clusters.list[c].members {
-                let m = m as usize;
-                let offset = b.seg_x[m] + shift - x;
-                let d = offset.norm();
-                if m == member || d <= T::zero() {
-                    continue;
-                }
-                let (n, gap) = (offset / d, d - r - b.radius[m]);
-                let closing = (b.chord[q] - b.chord[m]).dot(&n) * rest;
-                if self.rules.gravity.dot(&n) > T::zero() && (gap <= tolerance || closing > gap) {
-                    under.push((m, n, gap.max(T::zero())));
-                }
-            }
-        }
+        let under = self.members_under(q, c, member, n, shift, rest);
         // How fast the ball closes on member m beyond its gap.
         let excess = |b: &BallArrays<T, D>, &(m, n, gap): &(usize, Vector<T, D>, T)| {
             (b.chord[q] - b.chord[m]).dot(&n) - gap / rest
@@ -380,35 +440,88 @@ where
         }
         let under = load.under;
         // Below `floor` a closing is no event: held now, or the ball would sink into the
-        // cluster at that speed step after step. The members as immovable supports, at
-        // their chords after the solves, with whatever else holds the ball now.
+        // cluster at that speed step after step.
         let before = self.balls.vel[q];
         if under.iter().any(|t| excess(self.balls, t) > T::zero()) {
-            let b = &*self.balls;
-            let chord = b.chord[q];
-            let set = self.rest.at(q, s, h * T::lit(1e-6), chord, true);
-            for &(m, n, gap) in &under {
-                set.add(
-                    Support::Ball(m as u32),
-                    -n,
-                    -(b.chord[m].dot(&n) + gap / rest),
-                );
-            }
-            for (ball, touches) in self.touching {
-                for t in touches.iter().filter(|_| ball == q) {
-                    let member = matches!(t.support, Support::Ball(j) if Clusters::of(b, j as usize) == Some(c));
-                    if !member {
-                        set.add(t.support, -t.normal, -t.velocity.dot(&t.normal));
-                    }
-                }
-            }
-            if let Some(u) = set.project() {
-                let zero_spin = <Const<D> as Space<T, D>>::angular_zero();
-                self.balls.nudge(q, h, &(u - chord), &zero_spin);
-            }
+            self.hold_on_members(q, c, &under, s);
         } else {
             self.rest.restart(q, s, self.balls.chord[q]);
         }
+        self.end_on_members(q, c, &under, before, held);
+    }
+
+    /// The members of cluster `c` that ball `q` rests on, `member` (along `n`, from the
+    /// ball into it) first: every member below it that it touches or would reach along
+    /// the chords within the `rest` of the step, as `(member, unit normal from the ball
+    /// into it, gap)`; the members moved by `shift` to the ball's periodic image.
+    fn members_under(
+        &self,
+        q: usize,
+        c: usize,
+        member: usize,
+        n: &Vector<T, D>,
+        shift: &Vector<T, D>,
+        rest: T,
+    ) -> Vec<(usize, Vector<T, D>, T)> {
+        let mut under = vec![(member, *n, T::zero())];
+        let b = &*self.balls;
+        let (x, r) = (b.seg_x[q], b.radius[q]);
+        let tolerance = T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (x.amax() + r);
+        for &m in &self.clusters.list[c].members {
+            let m = m as usize;
+            let offset = b.seg_x[m] + shift - x;
+            let d = offset.norm();
+            if m == member || d <= T::zero() {
+                continue;
+            }
+            let (n, gap) = (offset / d, d - r - b.radius[m]);
+            let closing = (b.chord[q] - b.chord[m]).dot(&n) * rest;
+            if self.rules.gravity.dot(&n) > T::zero() && (gap <= tolerance || closing > gap) {
+                under.push((m, n, gap.max(T::zero())));
+            }
+        }
+        under
+    }
+
+    /// Holds ball `q` at `s` on the members `under` of cluster `c` as on immovable
+    /// supports, at their chords now, all at once with whatever else holds it (see
+    /// `rest`): the projection of its chord, frictionless.
+    fn hold_on_members(&mut self, q: usize, c: usize, under: &[(usize, Vector<T, D>, T)], s: T) {
+        let h = self.h;
+        let rest = h - s;
+        let b = &*self.balls;
+        let chord = b.chord[q];
+        let set = self.rest.at(q, s, h * T::lit(1e-6), chord, true);
+        for &(m, n, gap) in under {
+            let speed = b.chord[m].dot(&n) + gap / rest;
+            set.add(Support::Ball(m as u32), -n, -speed);
+        }
+        for (ball, touches) in self.touching {
+            for t in touches.iter().filter(|_| ball == q) {
+                let member = matches!(t.support, Support::Ball(j)
+                    if Clusters::of(b, j as usize) == Some(c));
+                if !member {
+                    set.add(t.support, -t.normal, -t.velocity.dot(&t.normal));
+                }
+            }
+        }
+        if let Some(u) = set.project() {
+            let zero_spin = <Const<D> as Space<T, D>>::angular_zero();
+            self.balls.nudge(q, h, &(u - chord), &zero_spin);
+        }
+    }
+
+    /// Ball `q`, held on the members `under` of cluster `c` (which its surfaces `held`
+    /// hold), ends the step as held (its end velocity was `before` the last hold).
+    fn end_on_members(
+        &mut self,
+        q: usize,
+        c: usize,
+        under: &[(usize, Vector<T, D>, T)],
+        before: Vector<T, D>,
+        mut held: Vec<Held<T, D>>,
+    ) {
+        let h = self.h;
         // The ball ends the step moving along the members' normals as its chord does
         // (`BallArrays::shift_chord`: with Verlet, RK4 or the exact integrator its end
         // velocity keeps half a step of gravity otherwise). The cluster's end velocity
@@ -672,53 +785,24 @@ where
         }
         let rest = self.h - self.clusters.list[c].seg_t;
         let rigid = self.clusters.list[c].start;
-        let centre = rigid.center();
-        let inverse_mass = T::one() / rigid.mass();
-        let inverse_inertia = rigid.world_inverse_inertia();
         let b = &*self.balls;
-        let arms: Vec<(Vector<T, D>, Vector<T, D>)> = contacts
-            .iter()
-            .map(|&(m, n, _, _)| {
-                let centre_arm = b.seg_x[m] - centre;
-                (centre_arm, centre_arm + n * b.radius[m])
-            })
-            .collect();
-        // A load's contact point is on the member, towards the ball.
-        let load_arms: Vec<(Vector<T, D>, Vector<T, D>)> = loads
-            .iter()
-            .map(|&(m, n, _)| {
-                let centre_arm = b.seg_x[m] - centre;
-                (centre_arm, centre_arm - n * b.radius[m])
-            })
-            .collect();
+        let mut delta = Delta::new(&rigid);
+        // Surface contacts at the member's surface towards the surface, loads at the
+        // member's surface towards the ball: (centre arm, contact arm).
+        let arm = |m: usize, towards: Vector<T, D>| {
+            let centre_arm = b.seg_x[m] - rigid.center();
+            (centre_arm, centre_arm + towards * b.radius[m])
+        };
+        let arms: Vec<_> = contacts.iter().map(|&(m, n, _, _)| arm(m, n)).collect();
+        let load_arms: Vec<_> = loads.iter().map(|&(m, n, _)| arm(m, -n)).collect();
         let (ball, ball_inverse_mass) = load.map_or((usize::MAX, T::zero()), |l| {
             (l.ball, b.inverse_mass[l.ball])
         });
         let ball_chord = load.map_or(Vector::zeros(), |l| b.chord[l.ball]);
-        let mut dv = Vector::<T, D>::zeros();
-        let mut dw = <Const<D> as Space<T, D>>::angular_zero();
         let mut dq = Vector::<T, D>::zeros();
         let mut normal = vec![T::zero(); contacts.len()];
         let mut tangential = vec![Vector::<T, D>::zeros(); contacts.len()];
         let mut carried = vec![T::zero(); loads.len()];
-        // Applies the impulse `p` at contact arm `a` to the chord velocities.
-        let push =
-            |p: &Vector<T, D>, a: &Vector<T, D>, dv: &mut Vector<T, D>, dw: &mut Angular<T, D>| {
-                *dv += p * inverse_mass;
-                *dw += <Const<D> as Space<T, D>>::inertia_apply(
-                    &inverse_inertia,
-                    &<Const<D> as Space<T, D>>::cross(a, p),
-                );
-            };
-        // The inverse effective mass of the rigid body at arm `a` along unit `d`.
-        let stiffness = |a: &Vector<T, D>, d: &Vector<T, D>| {
-            let ad = <Const<D> as Space<T, D>>::cross(a, d);
-            inverse_mass
-                + <Const<D> as Space<T, D>>::angular_dot(
-                    &ad,
-                    &<Const<D> as Space<T, D>>::inertia_apply(&inverse_inertia, &ad),
-                )
-        };
         let scale = contacts
             .iter()
             .map(|&(m, _, v, _)| (b.chord[m] - v).norm())
@@ -737,50 +821,32 @@ where
             let mut largest = T::zero();
             for (k, &(m, n, v, gap)) in contacts.iter().enumerate() {
                 let (centre_arm, a) = arms[k];
-                let relative = |dv: &Vector<T, D>, dw: &Angular<T, D>| {
-                    b.chord[m] + dv + <Const<D> as Space<T, D>>::angular_cross(dw, &centre_arm) - v
-                };
                 // Normal: `u·n > 0` closes on the surface, by at most the gap within the
                 // rest of the step (a speculative contact); push back along −n.
-                let approach = relative(&dv, &dw).dot(&n) - gap / rest;
-                let total = (normal[k] + approach / stiffness(&a, &n)).max(T::zero());
+                let approach = (b.chord[m] + delta.at(&centre_arm) - v).dot(&n) - gap / rest;
+                let total = (normal[k] + approach / delta.stiffness(&a, &n)).max(T::zero());
                 let step = total - normal[k];
                 normal[k] = total;
-                push(&(n * -step), &a, &mut dv, &mut dw);
-                largest = largest.max(step.abs() * stiffness(&a, &n));
-                // Friction: stop the tangential slip, within the cone |F_t| <= μ F_n.
+                delta.push(&(n * -step), &a);
+                largest = largest.max(step.abs() * delta.stiffness(&a, &n));
                 if self.rules.friction > T::zero() {
-                    let u = relative(&dv, &dw);
-                    let slip = u - n * u.dot(&n);
-                    let speed = slip.norm();
-                    if speed > T::zero() {
-                        let t = slip / speed;
-                        let wanted = tangential[k] - t * (speed / stiffness(&a, &t));
-                        let bound = self.rules.friction * normal[k];
-                        let total = if wanted.norm() > bound {
-                            wanted * (bound / wanted.norm())
-                        } else {
-                            wanted
-                        };
-                        let change = total - tangential[k];
-                        tangential[k] = total;
-                        push(&change, &a, &mut dv, &mut dw);
-                        largest = largest.max(change.norm() * stiffness(&a, &t));
-                    }
+                    let u = b.chord[m] + delta.at(&centre_arm) - v;
+                    let bound = self.rules.friction * normal[k];
+                    let change = delta.friction(&mut tangential[k], &u, &n, &a, bound);
+                    largest = largest.max(change);
                 }
             }
             // The ball's load on the members: two bodies, normal impulses only.
             for (k, &(m, n, gap)) in loads.iter().enumerate() {
                 let (centre_arm, a) = load_arms[k];
-                let member =
-                    b.chord[m] + dv + <Const<D> as Space<T, D>>::angular_cross(&dw, &centre_arm);
+                let member = b.chord[m] + delta.at(&centre_arm);
                 let approach = (ball_chord + dq - member).dot(&n) - gap / rest;
-                let mass = ball_inverse_mass + stiffness(&a, &n);
+                let mass = ball_inverse_mass + delta.stiffness(&a, &n);
                 let total = (carried[k] + approach / mass).max(T::zero());
                 let step = total - carried[k];
                 carried[k] = total;
                 dq -= n * (step * ball_inverse_mass);
-                push(&(n * step), &a, &mut dv, &mut dw);
+                delta.push(&(n * step), &a);
                 largest = largest.max(step.abs() * mass);
             }
             if largest <= T::lit(1e-12) * scale {
@@ -791,30 +857,42 @@ where
         // resting floor (a held cluster that needed no new impulse).
         let held: Vec<Held<T, D>> = contacts
             .iter()
-            .enumerate()
-            .filter(|&(k, &(m, n, v, gap))| {
-                let u = b.chord[m] + dv + <Const<D> as Space<T, D>>::angular_cross(&dw, &arms[k].0);
-                normal[k] > T::zero() || (u - v).dot(&n) - gap / rest >= -self.rules.floor
+            .zip(&arms)
+            .zip(&normal)
+            .filter(|&((&(m, n, v, gap), (centre_arm, _)), &pushed)| {
+                let u = b.chord[m] + delta.at(centre_arm) - v;
+                pushed > T::zero() || u.dot(&n) - gap / rest >= -self.rules.floor
             })
-            .map(|(_, &(m, n, v, _))| (m, n, v))
+            .map(|((&(m, n, v, _), _), _)| (m, n, v))
             .collect();
-        let mut rigid = rigid;
-        for (k, &(_, n, _, _)) in contacts.iter().enumerate() {
-            let p = tangential[k] - n * normal[k];
-            if p != Vector::<T, D>::zeros() {
-                rigid = rigid.with_impulse(&p, &arms[k].1);
-            }
-        }
-        for (k, &(_, n, _)) in loads.iter().enumerate() {
-            if carried[k] > T::zero() {
-                rigid = rigid.with_impulse(&(n * carried[k]), &load_arms[k].1);
-            }
-        }
-        if ball != usize::MAX && dq != Vector::<T, D>::zeros() {
+        let on_surfaces = (contacts
+            .iter()
+            .zip(&arms)
+            .zip(tangential.iter().zip(&normal)))
+        .map(|((&(_, n, _, _), arm), (t, &p))| (t - n * p, arm.1));
+        let of_loads = (loads.iter().zip(&load_arms).zip(&carried))
+            .map(|((&(_, n, _), arm), &p)| (n * p, arm.1));
+        let rigid = (on_surfaces.chain(of_loads))
+            .filter(|(p, _)| *p != Vector::<T, D>::zeros())
+            .fold(rigid, |r, (p, a)| r.with_impulse(&p, &a));
+        self.conclude_rest(c, rigid, held, ball, &dq)
+    }
+
+    /// Ends [`Self::rest_cluster`]: cluster `c` continues from `rigid` (the impulses
+    /// applied), its chord held on the surfaces `held` ([`Self::hold_end_velocity`], its
+    /// members held), and the ball it carried, if any, moves by `dq` (chord and velocity
+    /// alike: the impulses the cluster took are its whole change).
+    fn conclude_rest(
+        &mut self,
+        c: usize,
+        rigid: RigidCluster<T, D>,
+        held: Vec<Held<T, D>>,
+        ball: usize,
+        dq: &Vector<T, D>,
+    ) -> Vec<Held<T, D>> {
+        if ball != usize::MAX && *dq != Vector::<T, D>::zeros() {
             let zero_spin = <Const<D> as Space<T, D>>::angular_zero();
-            // The ball's chord and physical velocity change alike: the impulses the
-            // cluster takes are the ball's whole change.
-            self.balls.nudge(ball, self.h, &dq, &zero_spin);
+            self.balls.nudge(ball, self.h, dq, &zero_spin);
         }
         self.finish_cluster(c, rigid);
         if !held.is_empty() {
