@@ -27,6 +27,14 @@
 //!    corrected, converging geometrically, as do several members resting at once (a flat
 //!    cluster on the floor: each correction at one member changes the other's approach by
 //!    a factor below one).
+//! 5. **Stacks** (under gravity). A cluster held on its surfaces in the step (its
+//!    members count as held, as a ball on the floor does in `response`) takes a free
+//!    ball resting on it without the collapse guard's elastic impulse (which juggled the
+//!    ball, gaining energy): the ball's load and the cluster's surfaces are solved
+//!    together ([`Contacts::load_cluster`]), so that the surfaces carry the load, or the
+//!    cluster tips if its supports cannot. A member resting on a held free ball is held
+//!    by it as by an immovable surface moving at its chord (shock propagation, as for a
+//!    ball on a ball), with every held ball under the cluster's members at once.
 
 use carom_integrate::ForceField;
 use carom_math::{Real, Space, Vector};
