@@ -12,9 +12,9 @@ mod common;
 
 use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;
+use carom_sim::Simulation;
 use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
-use carom_sim::{Simulation, observe};
-use common::{Recorder, states, stepped};
+use common::{Recorder, assert_stays_put, states, stepped};
 use nalgebra::Vector2;
 
 const G: f64 = 9.81;
@@ -42,24 +42,9 @@ fn floor_world(restitution: f64, friction: f64, width: f64) -> World<f64, 2> {
 fn assert_at_rest(scene: &Scene<f64, 2>, integrator: Integrator, t: f64) -> u64 {
     let mut sim = stepped(scene, integrator, 1.0 / 600.0);
     let start = states(&sim);
-    let e0 = observe::energy(scene, &start);
     let mut rec = Recorder::default();
-    for k in 1..=10 {
-        sim.advance_to(t * f64::from(k) / 10.0, &mut rec).unwrap();
-        let now = states(&sim);
-        for (i, (p, q)) in now.pos.iter().zip(&start.pos).enumerate() {
-            assert!(
-                (p - q).norm() < 1e-9,
-                "{integrator}: ball {i} moved from {q:?} to {p:?}"
-            );
-            assert!(now.vel[i].norm() < 1e-9, "{integrator}: ball {i} moves");
-        }
-        let e = observe::energy(scene, &now);
-        assert!(
-            (e - e0).abs() < 1e-9 * e0.abs(),
-            "{integrator}: {e0} -> {e}"
-        );
-    }
+    let what = integrator.to_string();
+    assert_stays_put(&mut sim, scene, &start.pos, t, 10, 1e-9, &mut rec, &what);
     assert!(
         rec.collisions.is_empty(),
         "{:?}",

@@ -63,6 +63,10 @@ where
     pub(crate) seg_t: T,
     /// The rigid state at the end of the step (the state between steps).
     pub(crate) end: RigidCluster<T, D>,
+    /// Momentum added to the end state only, in this step: the reaction of a ball
+    /// resting on the cluster to the end of its own step (see `stick`'s `load_cluster`),
+    /// kept when the step is integrated again.
+    pub(crate) kick: Vector<T, D>,
     /// The member balls.
     pub(crate) members: Vec<u32>,
     /// Their offsets from the centre of mass, in the body frame.
@@ -155,10 +159,20 @@ impl<T: Real, const D: usize> StuckCluster<T, D>
 where
     Const<D>: Space<T, D>,
 {
-    /// The rigid state at in-step time `s >= seg_t` (the step started at internal time `t0`).
+    /// The rigid state at in-step time `s >= seg_t` of a step of length `h` (that started
+    /// at internal time `t0`): velocity, angular momentum and orientation advanced from
+    /// the segment start, the centre of mass on the chord between the segment's ends.
+    ///
+    /// The centre is where the members' chords put it (the mass-weighted mean of their
+    /// positions on their chords), as a ball restarts on its chord (`BallArrays::restart`):
+    /// the integrator's own sub-step from the segment start lies off the chord (by up to
+    /// `|g| τ²/8` under gravity, τ the segment's length: 3.4e-4 m at `h = 1/60 s`), and a
+    /// cluster restarted there at a contact jumped by that much, away from a support it
+    /// rests on (hovering, then falling onto it again every step) or into it.
     pub(crate) fn at<F: ForceField<T, D>>(
         &self,
         s: T,
+        h: T,
         stepper: &Stepper<T, D, F>,
         drag: T,
         t0: T,
@@ -166,14 +180,20 @@ where
         if s <= self.seg_t {
             return self.start;
         }
-        advance(
+        let moved = advance(
             &self.start,
             &self.offsets,
             stepper,
             drag,
             t0 + self.seg_t,
             s - self.seg_t,
-        )
+        );
+        let span = h - self.seg_t;
+        if span <= T::zero() {
+            return moved;
+        }
+        let (a, b) = (self.start.center(), self.end.center());
+        moved.with_pose(a + (b - a) * ((s - self.seg_t) / span), moved.orientation())
     }
 
     /// Starts a new segment at `s` from the rigid state `rigid` (the state at `s`,
@@ -194,7 +214,9 @@ where
         self.restart_members(balls, &rigid, s, h);
         self.start = rigid;
         self.seg_t = s;
-        self.end = advance(&rigid, &self.offsets, stepper, drag, t0 + s, h - s);
+        let end = advance(&rigid, &self.offsets, stepper, drag, t0 + s, h - s);
+        let kicked = end.velocity() + self.kick / end.mass();
+        self.end = end.with_motion(kicked, end.angular_momentum());
         self.set_member_ends(balls, h);
     }
 
@@ -268,6 +290,7 @@ where
             let rigid = cluster.end;
             cluster.start = rigid;
             cluster.seg_t = T::zero();
+            cluster.kick = Vector::zeros();
             cluster.end = advance(&rigid, &cluster.offsets, stepper, drag, t0, h);
             cluster.set_member_ends(balls, h);
         }
@@ -275,10 +298,16 @@ where
 
     /// Stops every cluster at in-step time `s` for the rest of the step (velocity and
     /// angular momentum kept), as the event budget does to every ball.
-    pub(crate) fn freeze<F: ForceField<T, D>>(&mut self, s: T, stepper: &Stepper<T, D, F>, t0: T) {
+    pub(crate) fn freeze<F: ForceField<T, D>>(
+        &mut self,
+        s: T,
+        h: T,
+        stepper: &Stepper<T, D, F>,
+        t0: T,
+    ) {
         let drag = self.drag;
         for cluster in &mut self.list {
-            let rigid = cluster.at(s, stepper, drag, t0);
+            let rigid = cluster.at(s, h, stepper, drag, t0);
             cluster.start = rigid;
             cluster.seg_t = s;
             cluster.end = rigid;
@@ -299,7 +328,7 @@ where
     ) {
         let drag = self.drag;
         for cluster in &mut self.list {
-            let rigid = cluster.at(s, stepper, drag, t0);
+            let rigid = cluster.at(s, h, stepper, drag, t0);
             let c = rigid.center();
             let shift = border.wrap(&c) - c;
             if shift == Vector::<T, D>::zeros() {

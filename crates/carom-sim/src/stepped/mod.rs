@@ -67,7 +67,7 @@ use self::narrow::{Event, Narrow, Overflow, Target};
 use self::obstacles::BoxArrays;
 use self::queue::EventQueue;
 use self::response::{Contacts, Effect, RestSets, Rules, Surface};
-use self::rest::{Support, Touch};
+use self::rest::{MemberSupport, Support, Touch};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
 
 /// Escapees per parallel task of the step's first predictions (each is a broad-phase
@@ -149,6 +149,9 @@ where
     /// Events of one ball's prediction (scratch).
     found: Vec<Event<T, D>>,
     touches: [Vec<Touch<T, D>>; 2],
+    /// The free balls under the members of the contact's clusters (scratch, see
+    /// [`Self::gather_member_supports`]).
+    member_supports: Vec<MemberSupport<T, D>>,
     clock: Clock<T>,
     counters: Counters,
     stats: StepStats,
@@ -248,6 +251,7 @@ where
             candidates: Vec::new(),
             found: Vec::new(),
             touches: [Vec::new(), Vec::new()],
+            member_supports: Vec::new(),
             clock: Clock {
                 dt,
                 k: 0,
@@ -620,6 +624,11 @@ where
         }
         let in_cluster = |b: &BallArrays<T, D>, k: usize| Clusters::of(b, k).is_some();
         let clustered = in_cluster(&self.balls, i) || in_cluster(&self.balls, other);
+        let mut member_supports = core::mem::take(&mut self.member_supports);
+        member_supports.clear();
+        if clustered && self.rules.gravity != Vector::<T, D>::zeros() {
+            self.gather_member_supports(i, other, e.time, &mut member_supports);
+        }
         let mut contacts = Contacts {
             balls: &mut self.balls,
             boxes: &self.boxes,
@@ -629,6 +638,7 @@ where
             rest: &mut self.rest,
             clusters: &mut self.clusters,
             touching: [(i, &touches[0]), (other, &touches[1])],
+            member_supports: &member_supports,
             h,
             t0,
         };
@@ -672,6 +682,7 @@ where
             }
         };
         self.touches = touches;
+        self.member_supports = member_supports;
         self.changed.clear();
         for ball in [i, other] {
             match Clusters::of(&self.balls, ball) {
@@ -780,10 +791,55 @@ where
         self.candidates = candidates;
     }
 
+    /// The free balls below the members of the clusters of balls `i` and `other` at
+    /// in-step time `s` (see [`Self::gather`]), which can hold the cluster up as a ball
+    /// below holds a ball (see `stick`). One support query per member: paid only by
+    /// contacts of clusters under gravity.
+    fn gather_member_supports(
+        &mut self,
+        i: usize,
+        other: usize,
+        s: T,
+        out: &mut Vec<MemberSupport<T, D>>,
+    ) {
+        let mut found = Vec::new();
+        let clusters = [i, other].map(|k| Clusters::of(&self.balls, k));
+        for (k, c) in clusters.iter().enumerate() {
+            let Some(c) = *c else { continue };
+            if k == 1 && clusters[0] == Some(c) {
+                continue;
+            }
+            for m in 0..self.clusters.list[c].members.len() {
+                let member = self.clusters.list[c].members[m] as usize;
+                found.clear();
+                self.gather(member, s, &mut found);
+                let x = self.balls.position_at(member, s);
+                for t in &found {
+                    let Support::Ball(j) = t.support else {
+                        continue;
+                    };
+                    if Clusters::of(&self.balls, j as usize).is_some() {
+                        continue;
+                    }
+                    // `gather` met ball j at its minimum image: keep the shift to it.
+                    let y = self.balls.position_at(j as usize, s);
+                    let shift = self
+                        .periodic
+                        .map_or_else(Vector::zeros, |p| p.minimum_image(&(y - x)) - (y - x));
+                    out.push(MemberSupport {
+                        member: member as u32,
+                        ball: j,
+                        shift,
+                    });
+                }
+            }
+        }
+    }
+
     /// Stops every ball and cluster at in-step time `s` for the rest of the step
     /// (velocities kept).
     fn freeze(&mut self, s: T, h: T, t0: T) {
-        self.clusters.freeze(s, &self.stepper, t0);
+        self.clusters.freeze(s, h, &self.stepper, t0);
         let b = &mut self.balls;
         for i in 0..b.len() {
             b.restart(i, s, h);

@@ -54,7 +54,8 @@ pub(crate) struct Event<T: Real, const D: usize> {
     /// The instant: the contact time in units of the simultaneity window (see
     /// [`Event::key_cmp`]).
     instant: u64,
-    /// The height of the lower body at contact, along gravity (zero without gravity).
+    /// The height of the lower body at contact, along gravity (zero without gravity): its
+    /// centre for two balls, the ball's lowest point against a wall or a box.
     height: T,
     /// In-step time of the contact.
     pub(crate) time: T,
@@ -195,6 +196,13 @@ where
         versions: [u32; 2],
         shift: Vector<T, D>,
     ) -> Prediction<T, D> {
+        if s >= self.end {
+            // Predicted at the window's end: no time is left to act in, and a resting
+            // contact there could only be found again unchanged (a member of a cluster
+            // held by a speculative contact reaches the surface exactly at the step's
+            // end), to the event budget. The next window or step starts with it.
+            return Ok(None);
+        }
         match toi.status {
             Status::Hit | Status::AlreadyTouching => {}
             Status::NoHit => return Ok(None),
@@ -213,7 +221,12 @@ where
                 let y = self.balls.position_at(j as usize, time) + shift;
                 -self.gravity.dot(&x).max(self.gravity.dot(&y))
             }
-            Target::Border | Target::Box(_) => -self.gravity.dot(&x),
+            // The ball's lowest point: a ball's support below it (a floor, a box) comes
+            // before the balls resting on it at the same centre height (a cluster resting
+            // on a row of balls finds all of them held).
+            Target::Border | Target::Box(_) => {
+                -self.gravity.dot(&x) - self.gravity.norm() * self.balls.radius[ball]
+            }
         };
         Ok(Some(Event {
             instant: (time / self.instant).floor().to_f64() as u64,

@@ -46,7 +46,7 @@ use nalgebra::Const;
 use super::balls::BallArrays;
 use super::clusters::Clusters;
 use super::obstacles::BoxArrays;
-use super::rest::{RestSet, Support, Touch};
+use super::rest::{MemberSupport, RestSet, Support, Touch};
 use crate::engine::Angular;
 use crate::scene::{Inelastic, Scene, SceneError};
 
@@ -150,7 +150,7 @@ impl<T: Real, const D: usize> RestSets<T, D> {
 
     /// Ball `i`'s set for the instant `s`, started afresh from `chord` if it was for
     /// another instant (or `fresh` asks for it: the chord changed by other means).
-    fn at(
+    pub(super) fn at(
         &mut self,
         i: usize,
         s: T,
@@ -174,7 +174,7 @@ impl<T: Real, const D: usize> RestSets<T, D> {
     }
 
     /// Ball `i`'s chord changed other than by a resting correction at `s`.
-    fn restart(&mut self, i: usize, s: T, chord: Vector<T, D>) {
+    pub(super) fn restart(&mut self, i: usize, s: T, chord: Vector<T, D>) {
         if self.slot[i] != u32::MAX {
             self.at(i, s, T::zero(), chord, true);
         }
@@ -198,6 +198,9 @@ where
     /// The supports the contact's balls touch now: `(ball, touches)` (gathered only
     /// under gravity; see `rest_on`).
     pub(crate) touching: [(usize, &'a [Touch<T, D>]); 2],
+    /// The free balls under the members of the contact's clusters (gathered only under
+    /// gravity; see `stick`).
+    pub(crate) member_supports: &'a [MemberSupport<T, D>],
     /// The step's length.
     pub(crate) h: T,
     /// The internal time of the step's start (for time-dependent fields).

@@ -1,14 +1,15 @@
 //! Helpers shared by the stepped-engine tests: building an engine from a scene with
-//! given options, collecting collisions, reading states.
+//! given options, collecting collisions, reading states, checking that a resting scene
+//! stays put.
 
 #![allow(dead_code)] // each test file uses a part
 
 use carom_integrate::Integrator;
-use carom_math::{Real, Space};
+use carom_math::{Real, Space, Vector};
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};
 use carom_sim::scene::Scene;
 use carom_sim::stepped::SteppedEngine;
-use carom_sim::{BallStates, Collision, Observer, Simulation};
+use carom_sim::{BallStates, Collision, Observer, Simulation, observe};
 use carom_toi::Direction;
 use nalgebra::Const;
 
@@ -68,5 +69,49 @@ impl<T: Real> Observer<T> for Recorder<T> {
     }
     fn progress(&mut self, t: T) {
         self.progress.push(t);
+    }
+}
+
+/// Advances `sim` from where it is to `until` in `samples` equal parts and checks at
+/// each that every ball is within `tolerance` (m) of `expected` and slower than
+/// `tolerance` (m/s), and that the energy is the one it had at the start to `tolerance`
+/// (relative): a resting stack does not move, sink, drift or gain energy. `what` names
+/// the run in the messages.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn assert_stays_put<const D: usize>(
+    sim: &mut SteppedEngine<f64, D>,
+    scene: &Scene<f64, D>,
+    expected: &[Vector<f64, D>],
+    until: f64,
+    samples: u32,
+    tolerance: f64,
+    observer: &mut dyn Observer<f64>,
+    what: &str,
+) where
+    Const<D>: Space<f64, D>,
+{
+    let from = sim.time();
+    let e0 = observe::energy(scene, &states(sim));
+    for k in 1..=samples {
+        let t = from + (until - from) * f64::from(k) / f64::from(samples);
+        sim.advance_to(t, observer).unwrap();
+        let now = states(sim);
+        for (i, (p, q)) in now.pos.iter().zip(expected).enumerate() {
+            assert!(
+                (p - q).norm() < tolerance,
+                "{what}, t = {t}: ball {i} at {p:?}, not {q:?} ({:.1e} m off)",
+                (p - q).norm()
+            );
+            assert!(
+                now.vel[i].norm() < tolerance,
+                "{what}, t = {t}: ball {i} moves at {:.1e} m/s",
+                now.vel[i].norm()
+            );
+        }
+        let e = observe::energy(scene, &now);
+        assert!(
+            (e - e0).abs() <= tolerance * e0.abs(),
+            "{what}, t = {t}: energy {e0} -> {e}"
+        );
     }
 }
