@@ -16,6 +16,7 @@ mod engine;
 pub mod event;
 pub mod observe;
 pub mod plan;
+mod prefetch;
 pub mod run;
 pub mod scene;
 pub mod scenes;

@@ -155,6 +155,13 @@ impl<T: Real> Calendar<T> {
             .map(|&b| (b as usize, self.time[b as usize]))
     }
 
+    /// Up to `k` of the next events' balls, the earliest first, the others in no
+    /// particular order: the top of the heap of the current bucket (with `k = 3` it holds
+    /// the next two events, when the bucket has them). For prefetching their data.
+    pub fn upcoming(&self, k: usize) -> &[u32] {
+        &self.heap[..self.heap.len().min(k)]
+    }
+
     /// Removes and returns the earliest event `(ball, time)`; ties go to the lower ball.
     pub fn pop(&mut self) -> Option<(usize, T)> {
         let (ball, t) = self.peek()?;

@@ -105,7 +105,7 @@ where
     pub(crate) fn predict_ball_vs_clusters(&self, i: usize, best_t: &mut T, best: &mut Pending) {
         let now = self.now;
         let ball = self.ball_at(i, now);
-        let kin = Kinematics::new_unchecked(self.balls.velocity_at(i, now), self.balls.accel[i]);
+        let kin = Kinematics::new_unchecked(self.balls.velocity_at(i, now), self.balls.accel(i));
         let options = self.advance_options();
         for (c, body) in self.clusters.iter().enumerate().filter(|(_, b)| b.alive) {
             let window = Window::forward(*best_t - now)
@@ -188,7 +188,7 @@ where
             }
             let ball = self.ball_at(j, now);
             let kin =
-                Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel[j]);
+                Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel(j));
             let toi = cluster_ball(&body.shape, &motion, &ball, &kin, &window(best_t), &options);
             consider(
                 toi.status,
@@ -287,7 +287,8 @@ where
         let mut best = (0, T::INFINITY);
         for k in 0..body.members.len() {
             let (centre, _) = body.member_state(k, self.now);
-            let gap = (p - centre).norm() - radius - self.balls.radius[body.members[k] as usize];
+            let gap =
+                (p - centre).norm() - radius - self.balls.motion[body.members[k] as usize].radius;
             if gap < best.1 {
                 best = (k, gap);
             }
@@ -307,11 +308,11 @@ where
         let now = self.now;
         self.sync_ball(j);
         self.clusters[c].sync(now);
-        let pj = self.balls.pos[j];
-        let rj = self.balls.radius[j];
+        let pj = self.balls.motion[j].pos;
+        let rj = self.balls.motion[j].radius;
         let (k, member_centre, n) = self.nearest_member(c, &pj, rj);
         let member = self.clusters[c].members[k] as usize;
-        let rk = self.balls.radius[member];
+        let rk = self.balls.motion[member].radius;
         let e = self.ball_restitution(member).min(self.ball_restitution(j));
         let com = self.clusters[c].rigid.center();
         if e == T::zero() && self.stick {
@@ -341,7 +342,7 @@ where
             body.rigid = body.rigid.with_impulse(&-r.impulse, &contact.offset_a());
             body.count = body.count.wrapping_add(1);
             body.last_collision = now;
-            self.balls.vel[j] = r.velocity[1];
+            self.balls.motion[j].vel = r.velocity[1];
             if self.friction > T::zero() {
                 self.balls.spin[j] = r.angular_velocity[1];
             }
@@ -372,8 +373,8 @@ where
             for b in 0..self.clusters[d].members.len() {
                 let (pa, _) = self.clusters[c].member_state(a, now);
                 let (pb, _) = self.clusters[d].member_state(b, now);
-                let ra = self.balls.radius[self.clusters[c].members[a] as usize];
-                let rb = self.balls.radius[self.clusters[d].members[b] as usize];
+                let ra = self.balls.motion[self.clusters[c].members[a] as usize].radius;
+                let rb = self.balls.motion[self.clusters[d].members[b] as usize].radius;
                 let gap = (pb - pa).norm() - ra - rb;
                 if gap < best.2 {
                     best = (a, b, gap);
@@ -391,7 +392,7 @@ where
             let (pa, _) = self.clusters[c].member_state(best.0, now);
             let (pb, _) = self.clusters[d].member_state(best.1, now);
             let n = (pb - pa) / (pb - pa).norm();
-            let (ra, rb) = (self.balls.radius[ma], self.balls.radius[mb]);
+            let (ra, rb) = (self.balls.motion[ma].radius, self.balls.motion[mb].radius);
             let contact = Contact::new_unchecked(
                 n,
                 pa + n * ra - self.clusters[c].rigid.center(),
@@ -451,7 +452,7 @@ where
         let body = &self.clusters[c];
         let gap_of = |k: usize| {
             let (p, _) = body.member_state(k, now);
-            let r = self.balls.radius[body.members[k] as usize];
+            let r = self.balls.motion[body.members[k] as usize].radius;
             if upper {
                 border.max()[axis] - p[axis] - r
             } else {
@@ -471,7 +472,7 @@ where
         let mut member = body.members[0] as usize;
         for k in (0..body.members.len()).filter(|&k| gap_of(k) <= touching) {
             let (p, _) = body.member_state(k, now);
-            let q = p + n * self.balls.radius[body.members[k] as usize];
+            let q = p + n * self.balls.motion[body.members[k] as usize].radius;
             lo = lo.inf(&q);
             hi = hi.sup(&q);
             member = body.members[k] as usize;
@@ -512,9 +513,9 @@ where
     fn ball_as_cluster(&self, j: usize) -> RigidCluster<T, D> {
         RigidCluster::ball(
             self.balls.mass[j],
-            self.balls.radius[j],
-            self.balls.pos[j],
-            self.balls.vel[j],
+            self.balls.motion[j].radius,
+            self.balls.motion[j].pos,
+            self.balls.motion[j].vel,
             self.balls.spin[j],
         )
         .expect("a validated ball is a valid rigid body")
@@ -529,7 +530,7 @@ where
             t_ref: self.now,
             members: vec![i as u32],
             offsets: vec![Vector::zeros()],
-            shape: Cluster::new(&[(Vector::zeros(), self.balls.radius[i])])
+            shape: Cluster::new(&[(Vector::zeros(), self.balls.motion[i].radius)])
                 .expect("one valid ball"),
             count: 0,
             last_collision: self.now,
@@ -585,7 +586,7 @@ where
         let shape_balls: Vec<(Vector<T, D>, T)> = members
             .iter()
             .zip(&offsets)
-            .map(|(&m, o)| (*o, self.balls.radius[m as usize]))
+            .map(|(&m, o)| (*o, self.balls.motion[m as usize].radius))
             .collect();
         let shape = Cluster::new(&shape_balls).map_err(|e| SimError {
             time: (now * self.sign).to_f64(),

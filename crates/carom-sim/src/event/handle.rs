@@ -46,7 +46,7 @@ where
                 let periodic = self.periodic_border().copied();
                 self.balls.sync(i, now, periodic.as_ref());
                 if let Partners::Lists(lists) = &mut self.partners {
-                    lists.rebuild(i, self.balls.pos[i]);
+                    lists.rebuild(i, self.balls.motion[i].pos);
                 }
                 self.predict(i);
             }
@@ -100,12 +100,12 @@ where
 
     /// Ball `i` as a carom-response body (synchronised).
     pub(crate) fn ball_body(&self, i: usize) -> Body<T, D> {
-        let (m, r) = (self.balls.mass[i], self.balls.radius[i]);
+        let (m, r) = (self.balls.mass[i], self.balls.motion[i].radius);
         let inertia = <Const<D> as Space<T, D>>::ball_inertia_factor() * m * r * r;
         Body::new_unchecked(
             T::one() / m,
             <Const<D> as Space<T, D>>::inertia_isotropic(T::one() / inertia),
-            self.balls.vel[i],
+            self.balls.motion[i].vel,
             self.balls.spin[i],
         )
     }
@@ -134,7 +134,7 @@ where
             return;
         };
         let (n, support_velocity) = self.support_frame(support);
-        if (self.balls.vel[i] - support_velocity).dot(&n) != T::zero() {
+        if (self.balls.motion[i].vel - support_velocity).dot(&n) != T::zero() {
             self.free(i);
         }
     }
@@ -160,9 +160,9 @@ where
     fn collide_balls(&mut self, i: usize, j: usize, observer: &mut dyn Observer<T>) {
         self.sync_ball(i);
         self.sync_ball(j);
-        let ci = self.balls.pos[i];
-        let cj = ci + self.separation(&ci, &self.balls.pos[j]);
-        let (ri, rj) = (self.balls.radius[i], self.balls.radius[j]);
+        let ci = self.balls.motion[i].pos;
+        let cj = ci + self.separation(&ci, &self.balls.motion[j].pos);
+        let (ri, rj) = (self.balls.motion[i].radius, self.balls.motion[j].radius);
         let Ok(contact) = Contact::between_balls(&ci, ri, &cj, rj) else {
             // Coincident centres cannot come from a predicted contact of positive radii.
             return;
@@ -184,8 +184,8 @@ where
         if !response.applied() {
             return;
         }
-        self.balls.vel[i] = response.velocity[0];
-        self.balls.vel[j] = response.velocity[1];
+        self.balls.motion[i].vel = response.velocity[0];
+        self.balls.motion[j].vel = response.velocity[1];
         // Without friction the impulse is central and cannot spin a ball; keeping the spin
         // as it is avoids the rounding of r × n (1e-17, not exactly 0).
         if self.friction > T::zero() {
@@ -227,9 +227,12 @@ where
         surface_restitution: T,
         support: Option<Support>,
     ) -> bool {
-        let r = self.balls.radius[i];
-        let contact =
-            Contact::new_unchecked(normal, normal * r, point - self.balls.pos[i] - normal * r);
+        let r = self.balls.motion[i].radius;
+        let contact = Contact::new_unchecked(
+            normal,
+            normal * r,
+            point - self.balls.motion[i].pos - normal * r,
+        );
         let a = self.ball_body(i);
         let b = Body::kinematic(surface_velocity, <Const<D> as Space<T, D>>::angular_zero())
             .unwrap_or_else(|_| Body::fixed());
@@ -249,7 +252,7 @@ where
         if !response.applied() {
             return false;
         }
-        self.balls.vel[i] = response.velocity[0];
+        self.balls.motion[i].vel = response.velocity[0];
         if self.friction > T::zero() {
             self.balls.spin[i] = response.angular_velocity[0];
         }
@@ -257,8 +260,8 @@ where
         if let (true, Some(s)) = (rest, support) {
             // Rest exactly: no normal velocity relative to the surface, no normal
             // acceleration; gravity's tangential part still drives the ball.
-            let v = self.balls.vel[i];
-            self.balls.vel[i] = v - normal * (v - surface_velocity).dot(&normal);
+            let v = self.balls.motion[i].vel;
+            self.balls.motion[i].vel = v - normal * (v - surface_velocity).dot(&normal);
             self.balls.accel[i] = self.gravity - normal * pressing;
             self.balls.mode[i] = Mode::Resting(s);
         } else {
@@ -272,7 +275,7 @@ where
         let Some(border) = self.border else { return };
         let mut normal = Vector::<T, D>::zeros();
         normal[axis] = if upper { T::one() } else { -T::one() };
-        let mut point = self.balls.pos[i];
+        let mut point = self.balls.motion[i].pos;
         point[axis] = if upper {
             border.max()[axis]
         } else {
@@ -299,7 +302,7 @@ where
         self.sync_ball(i);
         let b = self.boxes[k];
         let obb = b.at(self.now);
-        let centre = self.balls.pos[i];
+        let centre = self.balls.motion[i].pos;
         let image = obb.center() - self.separation(&centre, &obb.center());
         let boundary = obb.boundary_point(&image);
         // Work in the image's frame, then shift the contact point back to the ball.

@@ -29,6 +29,7 @@ mod cluster;
 mod handle;
 pub mod neighbours;
 mod predict;
+mod rows;
 mod state;
 
 use carom_geometry::{Ball, Border, Obb};
@@ -39,11 +40,12 @@ use nalgebra::Const;
 
 use crate::engine::{BallStates, Counters, EngineKind, Observer, SimError, Simulation};
 use crate::plan::{BroadChoice, Plan};
+use crate::prefetch::prefetch;
 use crate::scene::{Inelastic, Scene, SceneError};
 use calendar::Calendar;
 use cluster::ClusterBody;
 use neighbours::{Domain, NeighbourLists};
-use state::{Balls, Mode};
+use state::{Balls, Mode, Motion};
 
 /// At most this many balls are paired by testing every pair instead of neighbour lists
 /// (when `--broad auto`).
@@ -172,12 +174,19 @@ where
         let sign = direction.sign::<T>();
         let n = scene.balls.len();
         let balls = Balls {
-            pos: scene.balls.iter().map(|b| b.pos).collect(),
-            vel: scene.balls.iter().map(|b| b.vel * sign).collect(),
+            motion: scene
+                .balls
+                .iter()
+                .map(|b| Motion {
+                    pos: b.pos,
+                    vel: b.vel * sign,
+                    t_ref: T::zero(),
+                    radius: b.radius,
+                })
+                .collect(),
             spin: vec![<Const<D> as Space<T, D>>::angular_zero(); n],
             accel: vec![scene.world.gravity; n],
-            t_ref: vec![T::zero(); n],
-            radius: scene.balls.iter().map(|b| b.radius).collect(),
+            accelerated: scene.world.gravity != Vector::<T, D>::zeros(),
             mass: scene.balls.iter().map(|b| b.mass).collect(),
             restitution: scene.balls.iter().map(|b| b.restitution).collect(),
             count: vec![0; n],
@@ -305,7 +314,7 @@ where
     /// The ball `i` as a shape at time `t`.
     #[inline]
     pub(crate) fn ball_at(&self, i: usize, t: T) -> Ball<T, D> {
-        Ball::new_unchecked(self.balls.position_at(i, t), self.balls.radius[i])
+        Ball::new_unchecked(self.balls.position_at(i, t), self.balls.motion[i].radius)
     }
 
     pub(crate) fn periodic_border(&self) -> Option<&Border<T, D>> {
@@ -322,6 +331,54 @@ where
         match self.periodic_border() {
             Some(border) => border.minimum_image(&(b - a)),
             None => b - a,
+        }
+    }
+
+    /// Prefetches what the next events will read (see `crate::prefetch`): for the balls
+    /// at the top of the calendar, their pending event, state and neighbour list, while
+    /// the current event is handled (the misses on them were most of the engine's time).
+    fn prefetch_upcoming(&self, current: usize) {
+        let n = self.balls.len();
+        // The states of the current collision's partner's partners: predicted after the
+        // current ball's (its list was asked for at the previous event).
+        if current < n
+            && let (Pending::Ball { j, .. }, Partners::Lists(lists)) =
+                (self.pending[current], &self.partners)
+        {
+            for p in lists.partners(j as usize) {
+                prefetch(&self.balls.motion[p as usize]);
+            }
+        }
+        for &b in self.calendar.upcoming(3) {
+            let b = b as usize;
+            if b >= n {
+                continue;
+            }
+            prefetch(&self.pending[b]);
+            prefetch(&self.balls.motion[b]);
+            if let Partners::Lists(lists) = &self.partners {
+                lists.prefetch(b);
+            }
+        }
+        // The next event's partner, and the states of the next ball's partners (its
+        // pending event and list were asked for at the previous event, most likely).
+        if let Some(&b) = self.calendar.upcoming(1).first()
+            && (b as usize) < n
+        {
+            let b = b as usize;
+            if let Pending::Ball { j, .. } = self.pending[b] {
+                let j = j as usize;
+                prefetch(&self.balls.motion[j]);
+                prefetch(&self.balls.count[j]);
+                if let Partners::Lists(lists) = &self.partners {
+                    lists.prefetch(j);
+                }
+            }
+            if let Partners::Lists(lists) = &self.partners {
+                for p in lists.partners(b) {
+                    prefetch(&self.balls.motion[p as usize]);
+                }
+            }
         }
     }
 
@@ -385,6 +442,7 @@ where
                 break;
             }
             self.calendar.pop();
+            self.prefetch_upcoming(i);
             if t > self.now {
                 self.now = t;
                 self.events_at_instant = 0;
@@ -455,7 +513,11 @@ where
     Const<D>: Space<T, D>,
 {
     let n = balls.len();
-    let r_max = balls.radius.iter().copied().fold(T::zero(), T::max);
+    let r_max = balls
+        .motion
+        .iter()
+        .map(|m| m.radius)
+        .fold(T::zero(), T::max);
     let shell = list_shell(scene, balls);
     if let Some(b) = scene.world.border.filter(|b| b.periodic).map(|b| b.border) {
         // The minimum image is the only image within reach when every period is longer
@@ -492,8 +554,8 @@ where
         None => Domain::Unbounded,
     };
     Ok(Partners::Lists(NeighbourLists::new(
-        &balls.pos,
-        &balls.radius,
+        &balls.motion.iter().map(|m| m.pos).collect::<Vec<_>>(),
+        &balls.motion.iter().map(|m| m.radius).collect::<Vec<_>>(),
         shell,
         domain,
     )))
@@ -508,17 +570,21 @@ where
     Const<D>: Space<T, D>,
 {
     let n = balls.len().max(1);
-    let r_mean = balls.radius.iter().copied().fold(T::zero(), |a, b| a + b) / T::from_count(n);
-    let r_max = balls.radius.iter().copied().fold(T::zero(), T::max);
+    let r_mean = balls.motion.iter().fold(T::zero(), |a, m| a + m.radius) / T::from_count(n);
+    let r_max = balls
+        .motion
+        .iter()
+        .map(|m| m.radius)
+        .fold(T::zero(), T::max);
     let volume = scene.world.border.map_or_else(
         || {
             let (mut lo, mut hi) = (
                 Vector::<T, D>::repeat(T::INFINITY),
                 Vector::<T, D>::repeat(-T::INFINITY),
             );
-            for p in &balls.pos {
-                lo = lo.inf(p);
-                hi = hi.sup(p);
+            for m in &balls.motion {
+                lo = lo.inf(&m.pos);
+                hi = hi.sup(&m.pos);
             }
             (hi - lo).add_scalar(T::lit(2.0) * r_max).product()
         },
@@ -550,15 +616,19 @@ where
 {
     let n = balls.len();
     let g = scene.world.gravity.norm();
-    let r_min = balls.radius.iter().copied().fold(T::INFINITY, T::min);
+    let r_min = balls
+        .motion
+        .iter()
+        .map(|m| m.radius)
+        .fold(T::INFINITY, T::min);
     let r_scale = if r_min.finite() { r_min } else { T::one() };
     let rms = if n == 0 {
         T::zero()
     } else {
         (balls
-            .vel
+            .motion
             .iter()
-            .map(Vector::norm_squared)
+            .map(|m| m.vel.norm_squared())
             .fold(T::zero(), |a, b| a + b)
             / T::from_count(n))
         .sqrt()

@@ -12,8 +12,11 @@
 //! Anchors are binned in a grid of cells at least `2 r_max + 2δ` wide, so a rebuild only
 //! looks at the `3^D` cells around the anchor. Bounded domains (walls or periodic) index
 //! cells directly (wrapping for periodic); unbounded ones hash the integer cell
-//! coordinates into a table of about `2N` heads. Candidates met twice (hash clashes,
-//! fewer than 3 cells per periodic axis) are skipped with a per-ball stamp.
+//! coordinates into a table of about `2N` cells. A cell's balls, like a ball's partners,
+//! are kept in a cache-aligned row (module `rows`), so a rebuild reads each of its
+//! cells in one miss and then every candidate's anchor at once (a linked list through
+//! the balls read them one after the other). A cell met twice among the `3^D` (hash
+//! clashes, fewer than 3 cells per periodic axis) is read once.
 //!
 //! Very mixed radii make the cells (sized by the largest ball) hold many small balls;
 //! the lists stay exact, only rebuilds get slower.
@@ -21,7 +24,21 @@
 use carom_geometry::Border;
 use carom_math::{Real, Vector, floor_to_i64};
 
-const NONE: u32 = u32::MAX;
+use super::rows::IdRows;
+use crate::prefetch::prefetch;
+
+/// Balls kept in a cell's row (a 64-byte row; a cell holds about 3 (2D) to 4 (3D) at the
+/// engine's shell, more spill).
+const CELL_ROW: usize = 15;
+/// Partners kept in a ball's row (128 bytes; the engine aims at 10 (2D) to 16 (3D)).
+const LIST_ROW: usize = 31;
+
+/// A ball's anchor and radius, read together for each candidate of a rebuild.
+#[derive(Clone, Copy, Debug)]
+struct Anchored<T: Real, const D: usize> {
+    anchor: Vector<T, D>,
+    radius: T,
+}
 
 /// The domain the anchors live in.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,15 +83,12 @@ pub struct NeighbourLists<T: Real, const D: usize> {
     cells: Cells<T, D>,
     /// The periodic box, for minimum images.
     period: Option<Border<T, D>>,
-    heads: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
+    /// The balls anchored in each cell.
+    members: IdRows<CELL_ROW>,
+    /// The cell of each ball's anchor.
     cell_of: Vec<u32>,
-    anchor: Vec<Vector<T, D>>,
-    radius: Vec<T>,
-    lists: Vec<Vec<u32>>,
-    stamp: Vec<u32>,
-    current_stamp: u32,
+    balls: Vec<Anchored<T, D>>,
+    lists: IdRows<LIST_ROW>,
 }
 
 impl<T: Real, const D: usize> NeighbourLists<T, D> {
@@ -128,19 +142,19 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
             inv_cell: width.map(|w| T::one() / w),
             cells,
             period,
-            heads: vec![NONE; table],
-            next: vec![NONE; n],
-            prev: vec![NONE; n],
-            cell_of: vec![NONE; n],
-            anchor: positions.to_vec(),
-            radius: radii.to_vec(),
-            lists: vec![Vec::new(); n],
-            stamp: vec![0; n],
-            current_stamp: 0,
+            members: IdRows::new(table),
+            cell_of: vec![0; n],
+            balls: positions
+                .iter()
+                .zip(radii)
+                .map(|(&anchor, &radius)| Anchored { anchor, radius })
+                .collect(),
+            lists: IdRows::new(n),
         };
         for i in 0..n {
-            let c = lists.cell_index(&lists.anchor[i]);
-            lists.insert_in_cell(i as u32, c);
+            let c = lists.cell_index(&lists.balls[i].anchor);
+            lists.members.push(c, i as u32);
+            lists.cell_of[i] = c as u32;
         }
         for i in 0..n {
             lists.collect_partners(i, true);
@@ -155,12 +169,30 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
 
     /// The anchor of ball `i`.
     pub fn anchor(&self, i: usize) -> &Vector<T, D> {
-        &self.anchor[i]
+        &self.balls[i].anchor
     }
 
-    /// The partners of ball `i`.
-    pub fn partners(&self, i: usize) -> &[u32] {
-        &self.lists[i]
+    /// The partners of ball `i`, in no particular order.
+    pub fn partners(&self, i: usize) -> impl Iterator<Item = u32> + '_ {
+        self.lists.of(i)
+    }
+
+    /// Asks for ball `i`'s anchor and list to be brought into the cache (see
+    /// `crate::prefetch`).
+    #[inline]
+    pub(crate) fn prefetch(&self, i: usize) {
+        prefetch(&self.balls[i]);
+        self.lists.prefetch(i);
+    }
+
+    /// The integer coordinates of the neighbour `offset` (`0..3^D`) of cell `base`.
+    fn around(base: [i64; D], offset: usize) -> [i64; D] {
+        let mut rest = offset;
+        core::array::from_fn(|k| {
+            let o = (rest % 3) as i64 - 1;
+            rest /= 3;
+            base[k] + o
+        })
     }
 
     /// The separation `b − a`, as the minimum image in a periodic domain.
@@ -175,57 +207,46 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
     /// Re-anchors ball `i` at `position` and rebuilds its list (and its place in its
     /// partners' lists).
     pub fn rebuild(&mut self, i: usize, position: Vector<T, D>) {
-        let old = std::mem::take(&mut self.lists[i]);
-        for &j in &old {
-            let list = &mut self.lists[j as usize];
-            if let Some(k) = list.iter().position(|&x| x as usize == i) {
-                list.swap_remove(k);
-            }
-        }
-        self.lists[i] = old;
-        self.lists[i].clear();
-        self.remove_from_cell(i as u32);
-        self.anchor[i] = position;
+        self.lists.unlink(i);
+        self.members.remove(self.cell_of[i] as usize, i as u32);
+        self.balls[i].anchor = position;
         let c = self.cell_index(&position);
-        self.insert_in_cell(i as u32, c);
+        self.members.push(c, i as u32);
+        self.cell_of[i] = c as u32;
         self.collect_partners(i, false);
     }
 
     /// Finds the partners of `i` in the cells around its anchor. With `only_higher`
     /// (the initial build) each pair is found once from its lower index.
     fn collect_partners(&mut self, i: usize, only_higher: bool) {
-        self.current_stamp = self.current_stamp.wrapping_add(1);
-        if self.current_stamp == 0 {
-            self.stamp.fill(0);
-            self.current_stamp = 1;
-        }
-        self.stamp[i] = self.current_stamp;
-        let a = self.anchor[i];
+        const MAX_CELLS: usize = 27;
+        let Anchored { anchor: a, radius } = self.balls[i];
         let base = self.cell_coords(&a);
-        let two = T::lit(2.0);
+        // The cells around the anchor, each once.
+        let mut around = [0usize; MAX_CELLS];
+        let mut count = 0;
         for offset in 0..3usize.pow(D as u32) {
-            let mut rest = offset;
-            let coords: [i64; D] = core::array::from_fn(|k| {
-                let o = (rest % 3) as i64 - 1;
-                rest /= 3;
-                base[k] + o
-            });
-            let Some(c) = self.index_of(coords) else {
-                continue;
-            };
-            let mut j = self.heads[c];
-            while j != NONE {
+            if let Some(c) = self.index_of(Self::around(base, offset))
+                && !around[..count].contains(&c)
+            {
+                around[count] = c;
+                count += 1;
+            }
+        }
+        let two = T::lit(2.0);
+        for &c in &around[..count] {
+            for k in 0..self.members.len(c) {
+                let j = self.members.get(c, k);
                 let ju = j as usize;
-                let next = self.next[ju];
-                if self.stamp[ju] != self.current_stamp && (!only_higher || ju > i) {
-                    self.stamp[ju] = self.current_stamp;
-                    let reach = self.radius[i] + self.radius[ju] + two * self.shell;
-                    if self.separation(&a, &self.anchor[ju]).norm_squared() < reach * reach {
-                        self.lists[i].push(j);
-                        self.lists[ju].push(i as u32);
-                    }
+                if ju == i || (only_higher && ju < i) {
+                    continue;
                 }
-                j = next;
+                let other = &self.balls[ju];
+                let reach = radius + other.radius + two * self.shell;
+                if self.separation(&a, &other.anchor).norm_squared() < reach * reach {
+                    self.lists.push(i, j);
+                    self.lists.push(ju, i as u32);
+                }
             }
         }
     }
@@ -290,7 +311,7 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
                     h = (h ^ (x as u64)).wrapping_mul(0x0000_0100_0000_01b3);
                     h ^= h >> 29;
                 }
-                Some((h as usize) & (self.heads.len() - 1))
+                Some((h as usize) & (self.members.count() - 1))
             }
         }
     }
@@ -298,30 +319,6 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
     fn cell_index(&self, p: &Vector<T, D>) -> usize {
         self.index_of(self.cell_coords(p))
             .expect("a point's own cell always exists")
-    }
-
-    fn insert_in_cell(&mut self, i: u32, c: usize) {
-        let head = self.heads[c];
-        self.next[i as usize] = head;
-        self.prev[i as usize] = NONE;
-        if head != NONE {
-            self.prev[head as usize] = i;
-        }
-        self.heads[c] = i;
-        self.cell_of[i as usize] = c as u32;
-    }
-
-    fn remove_from_cell(&mut self, i: u32) {
-        let c = self.cell_of[i as usize] as usize;
-        let (p, n) = (self.prev[i as usize], self.next[i as usize]);
-        if p == NONE {
-            self.heads[c] = n;
-        } else {
-            self.next[p as usize] = n;
-        }
-        if n != NONE {
-            self.prev[n as usize] = p;
-        }
     }
 }
 
@@ -334,12 +331,13 @@ mod tests {
 
     /// Every pair within reach, by brute force.
     fn brute<const D: usize>(l: &NeighbourLists<f64, D>) -> BTreeSet<(usize, usize)> {
-        let n = l.anchor.len();
+        let n = l.balls.len();
         let mut s = BTreeSet::new();
         for i in 0..n {
             for j in i + 1..n {
-                let reach = l.radius[i] + l.radius[j] + 2.0 * l.shell;
-                if l.separation(&l.anchor[i], &l.anchor[j]).norm_squared() < reach * reach {
+                let (a, b) = (&l.balls[i], &l.balls[j]);
+                let reach = a.radius + b.radius + 2.0 * l.shell;
+                if l.separation(&a.anchor, &b.anchor).norm_squared() < reach * reach {
                     s.insert((i, j));
                 }
             }
@@ -349,10 +347,13 @@ mod tests {
 
     fn listed<const D: usize>(l: &NeighbourLists<f64, D>) -> BTreeSet<(usize, usize)> {
         let mut s = BTreeSet::new();
-        for i in 0..l.anchor.len() {
-            for &j in l.partners(i) {
+        for i in 0..l.balls.len() {
+            for j in l.partners(i) {
                 let j = j as usize;
-                assert!(l.partners(j).contains(&(i as u32)), "lists are symmetric");
+                assert!(
+                    l.partners(j).any(|x| x as usize == i),
+                    "lists are symmetric"
+                );
                 assert!(s.insert((i.min(j), i.max(j))) || i > j, "no duplicates");
             }
         }
@@ -453,7 +454,7 @@ mod tests {
             },
         );
         assert_eq!(listed(&l), brute(&l));
-        assert_eq!(l.partners(0), &[1]);
+        assert_eq!(l.partners(0).collect::<Vec<_>>(), [1]);
     }
 
     #[test]
@@ -464,7 +465,7 @@ mod tests {
             Vector2::new(0.21, 0.0),
         ];
         let l = NeighbourLists::new(&pos, &[0.1, 0.1, 0.1], 0.01, Domain::Unbounded);
-        assert_eq!(l.partners(0), &[2]);
-        assert!(l.partners(1).is_empty());
+        assert_eq!(l.partners(0).collect::<Vec<_>>(), [2]);
+        assert_eq!(l.partners(1).count(), 0);
     }
 }

@@ -32,7 +32,7 @@ where
         let mut best = self.own_event(i);
         let ball = self.ball_at(i, self.now);
         let kin =
-            Kinematics::new_unchecked(self.balls.velocity_at(i, self.now), self.balls.accel[i]);
+            Kinematics::new_unchecked(self.balls.velocity_at(i, self.now), self.balls.accel(i));
         self.offer_surfaces(&ball, &kin, &mut best);
         if !self.clusters.is_empty() {
             self.predict_ball_vs_clusters(i, &mut best.time, &mut best.pending);
@@ -56,7 +56,7 @@ where
             let s = exit_time(
                 &displacement,
                 &velocity,
-                &self.balls.accel[i],
+                &self.balls.accel(i),
                 lists.shell() * T::lit(SHELL_SAFETY),
             );
             best.offer(now + s, Pending::Rebuild);
@@ -120,8 +120,11 @@ where
         let now = self.now;
         let periodic = self.periodic_border();
         let centre = ball.center();
+        // Without clusters no ball is stuck: the mode is not read (a cache miss per
+        // partner).
+        let clusters = !self.clusters.is_empty();
         let mut consider = |j: usize| {
-            if j == i || matches!(self.balls.mode[j], Mode::Stuck(_)) {
+            if j == i || (clusters && matches!(self.balls.mode[j], Mode::Stuck(_))) {
                 return;
             }
             let d = self.balls.position_at(j, now) - centre;
@@ -129,9 +132,9 @@ where
                 Some(border) => border.minimum_image(&d),
                 None => d,
             };
-            let other = Ball::new_unchecked(centre + d, self.balls.radius[j]);
+            let other = Ball::new_unchecked(centre + d, self.balls.motion[j].radius);
             let kin_j =
-                Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel[j]);
+                Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel(j));
             if let Some(s) = ball_ball(ball, kin, &other, &kin_j, &best.window(now)).hit_time() {
                 best.offer(
                     now + s,
@@ -144,7 +147,7 @@ where
         };
         match &self.partners {
             Partners::All => (0..self.balls.len()).for_each(&mut consider),
-            Partners::Lists(lists) => lists.partners(i).iter().for_each(|&j| consider(j as usize)),
+            Partners::Lists(lists) => lists.partners(i).for_each(|j| consider(j as usize)),
         }
     }
 
@@ -155,7 +158,7 @@ where
         let obb = b.at(self.now);
         let local = obb.to_local(&self.balls.position_at(i, self.now));
         let rel_v = obb.vector_to_local(&(self.balls.velocity_at(i, self.now) - b.vel));
-        let rel_a = obb.vector_to_local(&self.balls.accel[i]);
+        let rel_a = obb.vector_to_local(&self.balls.accel(i));
         let h = obb.half_extents();
         let window = Window::unbounded(carom_toi::Direction::Forward);
         let mut first: Option<T> = None;

@@ -23,8 +23,8 @@ use carom_math::{Real, Space, Vector};
 use nalgebra::Const;
 
 use super::clusters::FREE;
-use super::prefetch::prefetch;
 use crate::engine::Angular;
+use crate::prefetch::prefetch;
 use crate::scene::{Scene, SceneError};
 
 /// Every ball's properties, state and current segment, in scene order.

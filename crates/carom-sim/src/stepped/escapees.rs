@@ -16,8 +16,8 @@
 use carom_geometry::Aabb;
 use carom_math::Real;
 
-use super::prefetch::prefetch;
 use super::sweep::overlap;
+use crate::prefetch::prefetch;
 
 /// The most lanes a box is filed in; wider boxes go to the wide list.
 const MAX_LANES_PER_BOX: usize = 8;

@@ -46,7 +46,6 @@ mod escapees;
 mod forces;
 mod narrow;
 mod obstacles;
-mod prefetch;
 mod queue;
 mod response;
 mod rest;

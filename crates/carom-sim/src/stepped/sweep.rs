@@ -38,8 +38,8 @@ use rayon::prelude::*;
 use super::balls::BallArrays;
 use super::escapees::Escapees;
 use super::obstacles::BoxArrays;
-use super::prefetch::prefetch;
 use crate::plan::BroadChoice;
+use crate::prefetch::prefetch;
 
 /// Balls per parallel chunk of the data-parallel passes.
 pub(crate) const CHUNK: usize = 1024;

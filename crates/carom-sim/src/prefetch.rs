@@ -1,12 +1,12 @@
 //! Asking the CPU to bring a value into the cache before it is read.
 //!
-//! The in-step event loop is bound by cache misses on the rows of the balls each contact
-//! touches (a dozen arrays per ball, the partner lists, the partners' rows), which are
-//! scattered over memory many times the size of the caches at 1e5 balls. The loop knows
-//! which balls come next (`queue`), so it prefetches their data while it answers the
-//! current contact. A prefetch is only a hint: it reads nothing into the program, cannot
-//! fault, and changes no result. On targets without a prefetch instruction in
-//! `core::arch` it does nothing.
+//! Both engines' event loops are bound by cache misses on the data of the balls each event
+//! touches (their state, their partner lists, the partners' states), which are scattered
+//! over memory many times the size of the caches at 1e5 balls. Each loop knows which
+//! balls come next (the stepped engine's `queue`, the event engine's calendar), so it
+//! prefetches their data while it answers the current event. A prefetch is only a hint:
+//! it reads nothing into the program, cannot fault, and changes no result. On targets
+//! without a prefetch instruction in `core::arch` it does nothing.
 
 /// Asks for the cache line holding `x` (a no-op where the target has no prefetch).
 #[inline]
