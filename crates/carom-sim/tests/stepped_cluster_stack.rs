@@ -183,6 +183,29 @@ struct Settling {
     gain: f64,
 }
 
+impl Settling {
+    /// Checks that no step gained more than `gain` joules, nothing overlapped beyond
+    /// [`OVERLAP`] and the horizontal momentum stayed at rounding (`what` names the case).
+    fn check(&self, what: &str, gain: f64) {
+        assert!(
+            self.gain <= gain,
+            "{what}: gained {:.1e} J in a step",
+            self.gain
+        );
+        assert!(
+            self.overlap <= OVERLAP,
+            "{what}: overlap {:.1e} m {:?}",
+            self.overlap,
+            self.worst
+        );
+        assert!(
+            self.sideways <= 1e-12,
+            "{what}: horizontal momentum {:.1e}",
+            self.sideways
+        );
+    }
+}
+
 /// Runs `sim` step by step to `until`, recording overlaps, the horizontal momentum and
 /// energy gains.
 fn settle<const D: usize>(
@@ -240,22 +263,7 @@ where
     let seen = settle(&mut sim, scene, settling, &mut rec);
     let what = format!("{what}, {integrator}");
     // Energy: rounding of the energies themselves (|E| ~ 10 J) at most.
-    assert!(
-        seen.gain <= 1e-12,
-        "{what}: gained {:.1e} J in a step",
-        seen.gain
-    );
-    assert!(
-        seen.overlap <= OVERLAP,
-        "{what}: overlap {:.1e} m {:?}",
-        seen.overlap,
-        seen.worst
-    );
-    assert!(
-        seen.sideways <= 1e-12,
-        "{what}: horizontal momentum {:.1e}",
-        seen.sideways
-    );
+    seen.check(&what, 1e-12);
     assert_stays_put(
         &mut sim,
         scene,
@@ -308,20 +316,9 @@ fn a_ball_dropped_onto_a_cluster_settles_in_its_hollow_whatever_the_floor_restit
             hits >= 2,
             "{what}: the ball bounced on the cluster ({hits} hits)"
         );
-        assert!(seen.gain <= 1e-12, "{what}: gained {:.1e} J", seen.gain);
-        assert!(
-            seen.overlap <= OVERLAP,
-            "{what}: overlap {:.1e} m {:?}",
-            seen.overlap,
-            seen.worst
-        );
         // The ball fell on the symmetry axis onto a symmetric cluster: with no
         // horizontal momentum, everything ends where the placed stack rests.
-        assert!(
-            seen.sideways <= 1e-12,
-            "{what}: sideways {:.1e}",
-            seen.sideways
-        );
+        seen.check(&what, 1e-12);
         assert_stays_put(
             &mut sim,
             &s,
@@ -459,9 +456,7 @@ fn a_ball_pushing_the_top_of_a_standing_pair_tips_it_with_the_closed_form_angula
         "the ball at {:?}",
         st.pos[2]
     );
-    assert!(seen.gain <= 1e-12, "gained {:.1e} J", seen.gain);
-    assert!(seen.overlap <= OVERLAP, "overlap {:.1e} m", seen.overlap);
-    assert!(seen.sideways <= 1e-12, "sideways {:.1e}", seen.sideways);
+    seen.check("tipping pair", 1e-12);
     assert!(
         rec.collisions.len() == 1,
         "only the pair's fusion: {:?}",
