@@ -151,6 +151,8 @@ where
     /// The free balls under the members of the contact's clusters (scratch, see
     /// [`Self::gather_member_supports`]).
     member_supports: Vec<MemberSupport<T, D>>,
+    /// The supports of one member in [`Self::gather_member_supports`] (scratch).
+    member_touches: Vec<Touch<T, D>>,
     clock: Clock<T>,
     counters: Counters,
     stats: StepStats,
@@ -251,6 +253,7 @@ where
             found: Vec::new(),
             touches: [Vec::new(), Vec::new()],
             member_supports: Vec::new(),
+            member_touches: Vec::new(),
             clock: Clock {
                 dt,
                 k: 0,
@@ -801,7 +804,7 @@ where
         s: T,
         out: &mut Vec<MemberSupport<T, D>>,
     ) {
-        let mut found = Vec::new();
+        let mut found = core::mem::take(&mut self.member_touches);
         let clusters = [i, other].map(|k| Clusters::of(&self.balls, k));
         for (k, c) in clusters.iter().enumerate() {
             let Some(c) = *c else { continue };
@@ -833,6 +836,7 @@ where
                 }
             }
         }
+        self.member_touches = found;
     }
 
     /// Stops every ball and cluster at in-step time `s` for the rest of the step
