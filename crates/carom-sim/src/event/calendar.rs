@@ -422,6 +422,26 @@ mod tests {
     }
 
     #[test]
+    fn upcoming_starts_with_the_next_event_and_holds_the_one_after() {
+        // Five events in one bucket (width 1): after a peek fills the heap, the top three
+        // hold the earliest first and the second earliest among the others.
+        let mut c = Calendar::<f64>::new(6, 4, 1.0, 0.0);
+        for (ball, t) in [(0, 0.5), (1, 0.1), (2, 0.3), (3, 0.2), (4, 0.9)] {
+            c.schedule(ball, t);
+        }
+        assert_eq!(c.peek(), Some((1, 0.1)));
+        let top = c.upcoming(3).to_vec();
+        assert_eq!(top[0], 1);
+        assert!(
+            top[1..].contains(&3),
+            "the second event (ball 3) in {top:?}"
+        );
+        assert_eq!(c.upcoming(10).len(), 5);
+        c.pop();
+        assert_eq!(c.upcoming(1), &[3]);
+    }
+
+    #[test]
     fn rescheduling_replaces_and_infinity_cancels() {
         let mut c = Calendar::<f32>::sized_for(3, 1.0, 0.0);
         c.schedule(0, 2.0);

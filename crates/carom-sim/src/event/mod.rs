@@ -336,7 +336,8 @@ where
 
     /// Prefetches what the next events will read (see `crate::prefetch`): for the balls
     /// at the top of the calendar, their pending event, state and neighbour list, while
-    /// the current event is handled (the misses on them were most of the engine's time).
+    /// the current event is handled (their first reads were the largest stalls in a
+    /// profile; the measured gain is in `docs/event-engine.md`).
     fn prefetch_upcoming(&self, current: usize) {
         let n = self.balls.len();
         // The states of the current collision's partner's partners: predicted after the

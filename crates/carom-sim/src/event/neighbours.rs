@@ -13,10 +13,9 @@
 //! looks at the `3^D` cells around the anchor. Bounded domains (walls or periodic) index
 //! cells directly (wrapping for periodic); unbounded ones hash the integer cell
 //! coordinates into a table of about `2N` cells. A cell's balls, like a ball's partners,
-//! are kept in a cache-aligned row (module `rows`), so a rebuild reads each of its
-//! cells in one miss and then every candidate's anchor at once (a linked list through
-//! the balls read them one after the other). A cell met twice among the `3^D` (hash
-//! clashes, fewer than 3 cells per periodic axis) is read once.
+//! are kept in a cache-aligned row (module `rows`; a linked list through the balls with a
+//! per-ball stamp measured as fast, and needed more code). A cell met twice among the
+//! `3^D` (hash clashes, fewer than 3 cells per periodic axis) is read once.
 //!
 //! Very mixed radii make the cells (sized by the largest ball) hold many small balls;
 //! the lists stay exact, only rebuilds get slower.

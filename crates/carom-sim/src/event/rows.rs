@@ -4,18 +4,18 @@
 //! A prediction reads one ball's whole list, and a list rebuild edits the lists of a
 //! dozen partners and reads those of `3^D` cells, each at a random place in memory.
 //! Stored as one `Vec` per list, every list costs two dependent cache misses (the
-//! vector's header, then its data), and a cell kept as a linked list through its balls
-//! costs one per ball, one after the other. Here a list's length and its first `W` ids
-//! share one row aligned to the cache line: one miss per list (with `W = 31`, 128 bytes:
-//! the length and the first 15 ids share the first line, and the hardware's
-//! adjacent-line prefetch brings the second). Lists longer than a row (a large ball
-//! among small ones, a crowded cell) continue in a vector of their own, allocated only
-//! for those.
+//! vector's header, then its data). Here a list's length and its first `W` ids share one
+//! row aligned to the cache line: one miss per list (with `W = 31`, 128 bytes: the length
+//! and the first 15 ids share the first line, and the hardware's adjacent-line prefetch
+//! brings the second). Lists longer than a row (a large ball among small ones, a crowded
+//! cell) continue in a vector of their own, allocated only for those.
 //!
-//! Measured on the 2D gas of 1e5 balls at area fraction 0.3 (`event_throughput`): with a
-//! `Vec` per list, the rebuild's search of its old partners' lists was 60 % of the
-//! rebuild's samples and the first read of a list 27 % of the prediction's (see
-//! `docs/event-engine.md` for the throughput before and after).
+//! Measured on the 2D gas of 1e5 balls at area fraction 0.3 (`event_throughput`, `perf
+//! annotate`): with a `Vec` per neighbour list, the rebuild's search of its old partners'
+//! lists and their headers were about 60 % of the rebuild's samples, and the two reads of
+//! a list 27 % of the prediction's. The rows for neighbour lists gained 5–7 %; for the
+//! grid's cells (linked lists through the balls before) they measured level and are kept
+//! because they are simpler (see `docs/event-engine.md`).
 
 use crate::prefetch::prefetch;
 

@@ -133,3 +133,19 @@ where
         m.t_ref = t;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Motion;
+
+    #[test]
+    fn a_balls_motion_record_is_one_cache_line_for_f64_in_2d_and_3d() {
+        for size in [
+            core::mem::size_of::<Motion<f64, 2>>(),
+            core::mem::size_of::<Motion<f64, 3>>(),
+        ] {
+            assert_eq!(size, 64);
+        }
+        assert_eq!(core::mem::align_of::<Motion<f64, 2>>(), 64);
+    }
+}

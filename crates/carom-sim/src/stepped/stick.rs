@@ -602,8 +602,8 @@ where
         }
         // Held again on its surfaces if it still closes on them at all, however slowly:
         // below the resting floor that is no event, and a cluster carrying a ball would
-        // sink at that speed step after step (the solves above leave second-order
-        // rotation: 5e-10 m/s measured with the exact integrator).
+        // sink at that speed step after step (the solves above see the rotation their
+        // impulses add to first order only, and leave the rest).
         let b = &*self.balls;
         if held
             .iter()
