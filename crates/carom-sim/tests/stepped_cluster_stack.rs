@@ -332,6 +332,20 @@ fn a_ball_dropped_onto_a_cluster_settles_in_its_hollow_whatever_the_floor_restit
     }
 }
 
+/// A pyramid's base: three load-bearing balls `d` apart glued into one cluster by two
+/// small balls between them (the first five balls, glued).
+fn pyramid_base(d: f64) -> Vec<BallSpec<f64, 2>> {
+    let mut balls = vec![
+        ball(&[-2.0 * d, R], R, 1.0, 0.5),
+        ball(&[-d, GLUE], GLUE, 0.25, 0.0),
+        ball(&[0.0, R], R, 1.0, 0.5),
+        ball(&[d, GLUE], GLUE, 0.25, 0.0),
+        ball(&[2.0 * d, R], R, 1.0, 0.5),
+    ];
+    glue(&mut balls, &[(0, 1), (2, 1), (2, 3), (4, 3)], 0.01);
+    balls
+}
+
 #[test]
 fn a_column_on_a_standing_pair_and_a_pyramid_on_a_cluster_stay_put() {
     // A column: a glue ball on the floor, a load-bearing ball fused on top of it, two balls
@@ -348,17 +362,12 @@ fn a_column_on_a_standing_pair_and_a_pyramid_on_a_cluster_stay_put() {
     // two hollows, and one in the hollow those two make.
     let d = spread();
     let h = above(d);
-    let mut pyramid = vec![
-        ball(&[-2.0 * d, R], R, 1.0, 0.5),
-        ball(&[-d, GLUE], GLUE, 0.25, 0.0),
-        ball(&[0.0, R], R, 1.0, 0.5),
-        ball(&[d, GLUE], GLUE, 0.25, 0.0),
-        ball(&[2.0 * d, R], R, 1.0, 0.5),
+    let mut pyramid = pyramid_base(d);
+    pyramid.extend([
         ball(&[-d, R + h], R, 1.0, 1.0),
         ball(&[d, R + h], R, 1.0, 1.0),
         ball(&[0.0, R + 2.0 * h], R, 1.0, 1.0),
-    ];
-    glue(&mut pyramid, &[(0, 1), (2, 1), (2, 3), (4, 3)], 0.01);
+    ]);
     let (pyramid, pyramid_rest) = lifted(world::<2>(0.5, 2.0), pyramid, LIFT);
     for integrator in INTEGRATORS {
         rests_at(&column, &column_rest, integrator, 1.0, "column");
@@ -372,15 +381,8 @@ fn a_ball_off_centre_on_a_cluster_held_on_both_sides_of_it_stays_put() {
     // passes between the cluster's outer supports (x = ±2d), so statics holds it, although
     // it is off the cluster's centre of mass (a torque the floor takes).
     let d = spread();
-    let mut balls = vec![
-        ball(&[-2.0 * d, R], R, 1.0, 0.5),
-        ball(&[-d, GLUE], GLUE, 0.25, 0.0),
-        ball(&[0.0, R], R, 1.0, 0.5),
-        ball(&[d, GLUE], GLUE, 0.25, 0.0),
-        ball(&[2.0 * d, R], R, 1.0, 0.5),
-        ball(&[d, R + above(d)], R, 1.0, 1.0),
-    ];
-    glue(&mut balls, &[(0, 1), (2, 1), (2, 3), (4, 3)], 0.01);
+    let mut balls = pyramid_base(d);
+    balls.push(ball(&[d, R + above(d)], R, 1.0, 1.0));
     let (s, rest) = lifted(world::<2>(0.5, 2.0), balls, LIFT);
     for integrator in INTEGRATORS {
         rests_at(&s, &rest, integrator, 1.0, "off-centre ball");
