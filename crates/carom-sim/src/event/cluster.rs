@@ -326,7 +326,7 @@ where
             let approach = -normal_velocity(&a, &b, &contact);
             let since = [
                 now - self.clusters[c].last_collision,
-                now - self.balls.last_collision[j],
+                now - self.balls.props[j].last_collision,
             ];
             let e = self.collapse.restitution(e, approach, since);
             let r = resolve(
@@ -344,10 +344,10 @@ where
             body.last_collision = now;
             self.balls.motion[j].vel = r.velocity[1];
             if self.friction > T::zero() {
-                self.balls.spin[j] = r.angular_velocity[1];
+                self.balls.props[j].spin = r.angular_velocity[1];
             }
             self.balls.count[j] = self.balls.count[j].wrapping_add(1);
-            self.balls.last_collision[j] = now;
+            self.balls.props[j].last_collision = now;
         }
         self.counters.ball_ball += 1;
         observer.collision(&Collision::BallBall {
@@ -512,11 +512,11 @@ where
     /// Ball `j` (synchronised) as a rigid cluster of one.
     fn ball_as_cluster(&self, j: usize) -> RigidCluster<T, D> {
         RigidCluster::ball(
-            self.balls.mass[j],
+            self.balls.props[j].mass,
             self.balls.motion[j].radius,
             self.balls.motion[j].pos,
             self.balls.motion[j].vel,
-            self.balls.spin[j],
+            self.balls.props[j].spin,
         )
         .expect("a validated ball is a valid rigid body")
     }

@@ -57,7 +57,7 @@ where
             }
             Pending::Ball { j, count } => {
                 let j = j as usize;
-                if self.balls.count[j] != count || matches!(self.balls.mode[j], Mode::Stuck(_)) {
+                if self.balls.count[j] != count || self.is_stuck(j) {
                     self.predict(i);
                 } else if self.sticks(i, j) {
                     self.sync_ball(i);
@@ -100,13 +100,13 @@ where
 
     /// Ball `i` as a carom-response body (synchronised).
     pub(crate) fn ball_body(&self, i: usize) -> Body<T, D> {
-        let (m, r) = (self.balls.mass[i], self.balls.motion[i].radius);
+        let (m, r) = (self.balls.props[i].mass, self.balls.motion[i].radius);
         let inertia = <Const<D> as Space<T, D>>::ball_inertia_factor() * m * r * r;
         Body::new_unchecked(
             T::one() / m,
             <Const<D> as Space<T, D>>::inertia_isotropic(T::one() / inertia),
             self.balls.motion[i].vel,
-            self.balls.spin[i],
+            self.balls.props[i].spin,
         )
     }
 
@@ -114,7 +114,7 @@ where
     /// and remember when, for the collapse guard.
     fn changed(&mut self, i: usize) {
         self.balls.count[i] = self.balls.count[i].wrapping_add(1);
-        self.balls.last_collision[i] = self.now;
+        self.balls.props[i].last_collision = self.now;
     }
 
     /// Ball `i` flies freely again under gravity.
@@ -130,7 +130,7 @@ where
     /// support normal still matches the support's; otherwise it flies (and if it now
     /// presses into the support, the next prediction finds that contact at once).
     fn check_support(&mut self, i: usize) {
-        let Mode::Resting(support) = self.balls.mode[i] else {
+        let Some(support) = self.support_of(i) else {
             return;
         };
         let (n, support_velocity) = self.support_frame(support);
@@ -171,8 +171,8 @@ where
         let approach = -normal_velocity(&a, &b, &contact);
         let nominal = self.ball_restitution(i).min(self.ball_restitution(j));
         let since = [
-            self.now - self.balls.last_collision[i],
-            self.now - self.balls.last_collision[j],
+            self.now - self.balls.props[i].last_collision,
+            self.now - self.balls.props[j].last_collision,
         ];
         let e = self.collapse.restitution(nominal, approach, since);
         let response = resolve(
@@ -189,8 +189,8 @@ where
         // Without friction the impulse is central and cannot spin a ball; keeping the spin
         // as it is avoids the rounding of r × n (1e-17, not exactly 0).
         if self.friction > T::zero() {
-            self.balls.spin[i] = response.angular_velocity[0];
-            self.balls.spin[j] = response.angular_velocity[1];
+            self.balls.props[i].spin = response.angular_velocity[0];
+            self.balls.props[j].spin = response.angular_velocity[1];
         }
         self.changed(i);
         self.changed(j);
@@ -206,13 +206,17 @@ where
 
     /// The ball's restitution in ball–ball collisions: its own or the world's.
     pub(crate) fn ball_restitution(&self, i: usize) -> T {
-        self.balls.restitution[i].unwrap_or(self.world_restitution)
+        self.balls.props[i]
+            .restitution
+            .unwrap_or(self.world_restitution)
     }
 
     /// The restitution of ball `i` against a surface of restitution `surface`: the
     /// minimum of the ball's own value (if it has one) and the surface's.
     pub(crate) fn surface_restitution(&self, i: usize, surface: T) -> T {
-        self.balls.restitution[i].map_or(surface, |e| e.min(surface))
+        self.balls.props[i]
+            .restitution
+            .map_or(surface, |e| e.min(surface))
     }
 
     /// A bounce of ball `i` on an immovable surface moving at `surface_velocity`, along
@@ -254,7 +258,7 @@ where
         }
         self.balls.motion[i].vel = response.velocity[0];
         if self.friction > T::zero() {
-            self.balls.spin[i] = response.angular_velocity[0];
+            self.balls.props[i].spin = response.angular_velocity[0];
         }
         self.changed(i);
         if let (true, Some(s)) = (rest, support) {

@@ -45,7 +45,7 @@ use crate::scene::{Inelastic, Scene, SceneError};
 use calendar::Calendar;
 use cluster::ClusterBody;
 use neighbours::{Domain, NeighbourLists};
-use state::{Balls, Mode, Motion};
+use state::{Balls, Mode, Motion, Props, Support};
 
 /// At most this many balls are paired by testing every pair instead of neighbour lists
 /// (when `--broad auto`).
@@ -186,13 +186,19 @@ where
                     radius: b.radius,
                 })
                 .collect(),
-            spin: vec![<Const<D> as Space<T, D>>::angular_zero(); n],
+            props: scene
+                .balls
+                .iter()
+                .map(|b| Props {
+                    mass: b.mass,
+                    restitution: b.restitution,
+                    last_collision: -T::INFINITY,
+                    spin: <Const<D> as Space<T, D>>::angular_zero(),
+                })
+                .collect(),
             accel: vec![scene.world.gravity; n],
             accelerated: scene.world.gravity != Vector::<T, D>::zeros(),
-            mass: scene.balls.iter().map(|b| b.mass).collect(),
-            restitution: scene.balls.iter().map(|b| b.restitution).collect(),
             count: vec![0; n],
-            last_collision: vec![-T::INFINITY; n],
             mode: vec![Mode::Free; n],
         };
         let (border, border_restitution, periodic) = match &scene.world.border {
@@ -359,6 +365,7 @@ where
             }
             prefetch(&self.pending[b]);
             prefetch(&self.balls.motion[b]);
+            prefetch(&self.balls.props[b]);
             if let Partners::Lists(lists) = &self.partners {
                 lists.prefetch(b);
             }
@@ -372,6 +379,7 @@ where
             if let Pending::Ball { j, .. } = self.pending[b] {
                 let j = j as usize;
                 prefetch(&self.balls.motion[j]);
+                prefetch(&self.balls.props[j]);
                 prefetch(&self.balls.count[j]);
                 if let Partners::Lists(lists) = &self.partners {
                     lists.prefetch(j);
@@ -382,6 +390,39 @@ where
                     prefetch(&self.balls.motion[p as usize]);
                 }
             }
+        }
+    }
+
+    /// `true` if ball `i` is a member of a stuck cluster. Without clusters the mode is
+    /// not read: in a gas it is a cache miss at every prediction, and a ball's partners'
+    /// modes one more each.
+    #[inline]
+    pub(crate) fn is_stuck(&self, i: usize) -> bool {
+        !self.clusters.is_empty() && matches!(self.balls.mode[i], Mode::Stuck(_))
+    }
+
+    /// What ball `i` rests on, if it rests. Only gravity lets a ball rest (the resting
+    /// guard decides a rest only for a ball pressed onto its support), so without it the
+    /// mode is not read (a cache miss per prediction and per collision).
+    #[inline]
+    pub(crate) fn support_of(&self, i: usize) -> Option<Support> {
+        if !self.balls.accelerated {
+            return None;
+        }
+        match self.balls.mode[i] {
+            Mode::Resting(support) => Some(support),
+            _ => None,
+        }
+    }
+
+    /// Calendar slot `i` named for a message: `ball i` or `cluster c` (clusters take the
+    /// slots after the balls).
+    fn slot_name(&self, i: usize) -> String {
+        let n = self.balls.len();
+        if i < n {
+            format!("ball {i}")
+        } else {
+            format!("cluster {}", i - n)
         }
     }
 
@@ -455,8 +496,9 @@ where
                 return Err(SimError {
                     time: (self.now * self.sign).to_f64(),
                     message: format!(
-                        "more than {} events at one instant: a cascade of simultaneous collisions that does not end (ball {i})",
-                        MAX_EVENTS_PER_INSTANT_PER_BALL * self.balls.len().max(1)
+                        "more than {} events at one instant: a cascade of simultaneous collisions that does not end ({})",
+                        MAX_EVENTS_PER_INSTANT_PER_BALL * self.balls.len().max(1),
+                        self.slot_name(i)
                     ),
                 });
             }
@@ -479,7 +521,7 @@ where
             out.vel.push(v);
             let spin = match self.balls.mode[i] {
                 Mode::Stuck(c) => self.clusters[c].rigid.angular_velocity(),
-                _ => self.balls.spin[i],
+                _ => self.balls.props[i].spin,
             };
             out.spin
                 .push(spin * self.sign + <Const<D> as Space<T, D>>::angular_zero());

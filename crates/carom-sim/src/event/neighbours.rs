@@ -31,6 +31,8 @@ use crate::prefetch::prefetch;
 const CELL_ROW: usize = 15;
 /// Partners kept in a ball's row (128 bytes; the engine aims at 10 (2D) to 16 (3D)).
 const LIST_ROW: usize = 31;
+/// The most cells a rebuild looks at (`3^D` for `D <= 3`).
+const MAX_CELLS: usize = 27;
 
 /// A ball's anchor and radius, read together for each candidate of a rebuild.
 #[derive(Clone, Copy, Debug)]
@@ -88,6 +90,8 @@ pub struct NeighbourLists<T: Real, const D: usize> {
     cell_of: Vec<u32>,
     balls: Vec<Anchored<T, D>>,
     lists: IdRows<LIST_ROW>,
+    /// A rebuild's candidates (scratch, kept to avoid an allocation per rebuild).
+    candidates: Vec<u32>,
 }
 
 impl<T: Real, const D: usize> NeighbourLists<T, D> {
@@ -149,14 +153,17 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
                 .map(|(&anchor, &radius)| Anchored { anchor, radius })
                 .collect(),
             lists: IdRows::new(n),
+            candidates: Vec::new(),
         };
         for i in 0..n {
             let c = lists.cell_index(&lists.balls[i].anchor);
             lists.members.push(c, i as u32);
             lists.cell_of[i] = c as u32;
         }
+        let mut around = [0; MAX_CELLS];
         for i in 0..n {
-            lists.collect_partners(i, true);
+            let count = lists.cells_around(&lists.balls[i].anchor, &mut around);
+            lists.collect_partners(i, &around[..count], true);
         }
         lists
     }
@@ -206,23 +213,55 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
     /// Re-anchors ball `i` at `position` and rebuilds its list (and its place in its
     /// partners' lists).
     pub fn rebuild(&mut self, i: usize, position: Vector<T, D>) {
+        // The cells around the new anchor are read after the old partners' lists are
+        // edited: asked for first, both sets of misses overlap.
+        let mut around = [0; MAX_CELLS];
+        let count = self.cells_around(&position, &mut around);
+        for &c in &around[..count] {
+            self.members.prefetch(c);
+        }
         self.lists.unlink(i);
         self.members.remove(self.cell_of[i] as usize, i as u32);
         self.balls[i].anchor = position;
         let c = self.cell_index(&position);
         self.members.push(c, i as u32);
         self.cell_of[i] = c as u32;
-        self.collect_partners(i, false);
+        self.collect_partners(i, &around[..count], false);
     }
 
-    /// Finds the partners of `i` in the cells around its anchor. With `only_higher`
+    /// Finds the partners of `i` in the cells `around` its anchor. With `only_higher`
     /// (the initial build) each pair is found once from its lower index.
-    fn collect_partners(&mut self, i: usize, only_higher: bool) {
-        const MAX_CELLS: usize = 27;
+    fn collect_partners(&mut self, i: usize, around: &[usize], only_higher: bool) {
         let Anchored { anchor: a, radius } = self.balls[i];
-        let base = self.cell_coords(&a);
-        // The cells around the anchor, each once.
-        let mut around = [0usize; MAX_CELLS];
+        // The candidates' anchors are misses of their own: asked for all at once first.
+        self.candidates.clear();
+        for &c in around {
+            for k in 0..self.members.len(c) {
+                let j = self.members.get(c, k);
+                let ju = j as usize;
+                if ju != i && !(only_higher && ju < i) {
+                    prefetch(&self.balls[ju]);
+                    self.candidates.push(j);
+                }
+            }
+        }
+        let two = T::lit(2.0);
+        for k in 0..self.candidates.len() {
+            let j = self.candidates[k];
+            let ju = j as usize;
+            let other = &self.balls[ju];
+            let reach = radius + other.radius + two * self.shell;
+            if self.separation(&a, &other.anchor).norm_squared() < reach * reach {
+                self.lists.push(i, j);
+                self.lists.push(ju, i as u32);
+            }
+        }
+    }
+
+    /// Writes the cells around the cell of `p` (its neighbours and itself, each once) to
+    /// the start of `around`, and returns their number.
+    fn cells_around(&self, p: &Vector<T, D>, around: &mut [usize; MAX_CELLS]) -> usize {
+        let base = self.cell_coords(p);
         let mut count = 0;
         for offset in 0..3usize.pow(D as u32) {
             if let Some(c) = self.index_of(Self::around(base, offset))
@@ -232,22 +271,7 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
                 count += 1;
             }
         }
-        let two = T::lit(2.0);
-        for &c in &around[..count] {
-            for k in 0..self.members.len(c) {
-                let j = self.members.get(c, k);
-                let ju = j as usize;
-                if ju == i || (only_higher && ju < i) {
-                    continue;
-                }
-                let other = &self.balls[ju];
-                let reach = radius + other.radius + two * self.shell;
-                if self.separation(&a, &other.anchor).norm_squared() < reach * reach {
-                    self.lists.push(i, j);
-                    self.lists.push(ju, i as u32);
-                }
-            }
-        }
+        count
     }
 
     fn cell_coords(&self, p: &Vector<T, D>) -> [i64; D] {

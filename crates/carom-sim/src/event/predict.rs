@@ -10,7 +10,7 @@ use carom_math::{Real, Space, Vector};
 use carom_toi::{Kinematics, Window, ball_ball, ball_border, ball_obb, level_crossing};
 use nalgebra::Const;
 
-use super::state::{Mode, Support};
+use super::state::Support;
 use super::{EventEngine, Partners, Pending};
 
 /// A rebuild is scheduled when the ball has moved this fraction of the shell, keeping a
@@ -24,7 +24,7 @@ where
     /// Predicts and schedules ball `i`'s next event (balls in clusters are scheduled by
     /// their cluster).
     pub(crate) fn predict(&mut self, i: usize) {
-        if let Mode::Stuck(_) = self.balls.mode[i] {
+        if self.is_stuck(i) {
             self.pending[i] = Pending::None;
             self.calendar.cancel(i);
             return;
@@ -61,7 +61,7 @@ where
             );
             best.offer(now + s, Pending::Rebuild);
         }
-        if let Mode::Resting(Support::BoxFace { k, axis, .. }) = self.balls.mode[i]
+        if let Some(Support::BoxFace { k, axis, .. }) = self.support_of(i)
             && let Some(s) = self.face_exit_time(i, k, axis)
         {
             best.offer(now + s, Pending::LeaveSupport);
@@ -120,11 +120,8 @@ where
         let now = self.now;
         let periodic = self.periodic_border();
         let centre = ball.center();
-        // Without clusters no ball is stuck: the mode is not read (a cache miss per
-        // partner).
-        let clusters = !self.clusters.is_empty();
         let mut consider = |j: usize| {
-            if j == i || (clusters && matches!(self.balls.mode[j], Mode::Stuck(_))) {
+            if j == i || self.is_stuck(j) {
                 return;
             }
             let d = self.balls.position_at(j, now) - centre;

@@ -124,6 +124,11 @@ impl<const W: usize> IdRows<W> {
     /// from the lists of all the ids on its list, and empties list `i`.
     pub(crate) fn unlink(&mut self, i: usize) {
         let len = self.len(i);
+        // Each partner's row is a miss of its own: asked for all at once, they arrive
+        // together instead of one after the other.
+        for k in 0..len {
+            self.prefetch(self.get(i, k) as usize);
+        }
         for k in 0..len {
             let j = self.get(i, k);
             debug_assert_ne!(j as usize, i, "a ball is not its own partner");

@@ -52,6 +52,23 @@ pub(crate) struct Motion<T: Real, const D: usize> {
     pub(crate) radius: T,
 }
 
+/// What a collision's response reads and writes of a ball besides its motion, in one
+/// record (one cache line for `f64` in 2D and 3D): where these were four arrays, a
+/// collision cost a miss in each for both balls (see `docs/event-engine.md`).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct Props<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    pub(crate) mass: T,
+    /// The ball's own restitution override, if any.
+    pub(crate) restitution: Option<T>,
+    /// When the ball last collided (for the collapse guard); −∞ if never.
+    pub(crate) last_collision: T,
+    pub(crate) spin: Angular<T, D>,
+}
+
 /// The lazily advanced balls.
 #[derive(Clone, Debug)]
 pub(crate) struct Balls<T: Real, const D: usize>
@@ -59,18 +76,13 @@ where
     Const<D>: Space<T, D>,
 {
     pub(crate) motion: Vec<Motion<T, D>>,
-    pub(crate) spin: Vec<Angular<T, D>>,
+    pub(crate) props: Vec<Props<T, D>>,
     /// The acceleration of each ball (read only when `accelerated`).
     pub(crate) accel: Vec<Vector<T, D>>,
     /// `false` in a world without gravity, where every acceleration is zero: states are
     /// advanced without reading `accel`.
     pub(crate) accelerated: bool,
-    pub(crate) mass: Vec<T>,
-    /// The ball's own restitution override, if any.
-    pub(crate) restitution: Vec<Option<T>>,
     pub(crate) count: Vec<u32>,
-    /// When the ball last collided (for the collapse guard); −∞ if never.
-    pub(crate) last_collision: Vec<T>,
     pub(crate) mode: Vec<Mode>,
 }
 
@@ -136,16 +148,19 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::Motion;
+    use super::{Motion, Props};
 
     #[test]
-    fn a_balls_motion_record_is_one_cache_line_for_f64_in_2d_and_3d() {
+    fn a_balls_records_are_one_cache_line_each_for_f64_in_2d_and_3d() {
         for size in [
             core::mem::size_of::<Motion<f64, 2>>(),
             core::mem::size_of::<Motion<f64, 3>>(),
+            core::mem::size_of::<Props<f64, 2>>(),
+            core::mem::size_of::<Props<f64, 3>>(),
         ] {
             assert_eq!(size, 64);
         }
         assert_eq!(core::mem::align_of::<Motion<f64, 2>>(), 64);
+        assert_eq!(core::mem::align_of::<Props<f64, 3>>(), 64);
     }
 }
