@@ -145,8 +145,11 @@ impl<const W: usize> IdRows<W> {
 
     /// Empties list `i`.
     pub(crate) fn clear(&mut self, i: usize) {
+        // The spill is read only past the row: not touched (a miss) otherwise.
+        if self.rows[i].len as usize > W {
+            self.spill[i].clear();
+        }
         self.rows[i].len = 0;
-        self.spill[i].clear();
     }
 }
 
