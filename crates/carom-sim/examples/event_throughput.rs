@@ -11,8 +11,9 @@
 //! lattice; the untimed `RELAX` lets it reach equilibrium first, as `benches/event.rs`
 //! does: a relaxed gas costs more per collision than the lattice start (its lists hold
 //! more partners: contacts are more likely than in a uniform gas), so a run timed from
-//! the start reports more collisions per second than the engine sustains. The criterion bench `benches/event.rs` measures the
-//! same scenes with statistics; this example is the quick look.
+//! the start reports more collisions per second than the engine sustains. The criterion
+//! bench `benches/event.rs` measures the same scenes with statistics; this example is
+//! the quick look.
 
 use std::time::Instant;
 

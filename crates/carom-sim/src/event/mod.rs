@@ -55,7 +55,8 @@ pub const ALL_PAIRS_MAX_BALLS: usize = 32;
 /// follows from the density: dense gases get thin shells (lists of the nearest balls,
 /// rebuilt often), dilute ones thick shells (a ball flies far between rebuilds). Ten
 /// was the fastest of 7 to 24 in both dimensions, measured on the benchmark gases (2D
-/// N = 1e5 at area fraction 0.3, 3D N = 32,000 at packing 0.45; docs/event-engine.md).
+/// N = 1e5 at area fraction 0.3, 3D N = 32,000 at packing 0.45) from their lattice
+/// start, and level with 13 in the relaxed 3D gas (docs/event-engine.md).
 pub const LIST_PARTNERS_2D: f64 = 10.0;
 /// As [`LIST_PARTNERS_2D`], in 3D.
 pub const LIST_PARTNERS_3D: f64 = 10.0;
