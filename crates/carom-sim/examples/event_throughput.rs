@@ -2,8 +2,9 @@
 //! drift and (for up to 8,000 balls) the smallest gap between any two balls at the end.
 //!
 //! ```sh
-//! cargo run --release -p carom-sim --example event_throughput -- [N] [FRACTION] [DIM] [TIME] [RELAX]
+//! cargo run --release -p carom-sim --example event_throughput -- [N] [FRACTION] [DIM] [TIME] [RELAX] [SEARCH]
 //! cargo run --release -p carom-sim --example event_throughput -- 32000 0.45 3 1
+//! cargo run --release -p carom-sim --example event_throughput -- 100000 0.3 2 2 2 lists
 //! ```
 //!
 //! Defaults: N = 32,000, packing fraction 0.45, 3D, 1 time unit timed after 2 untimed
@@ -11,7 +12,9 @@
 //! lattice; the untimed `RELAX` lets it reach equilibrium first, as `benches/event.rs`
 //! does: a relaxed gas costs more per collision than the lattice start (its lists hold
 //! more partners: contacts are more likely than in a uniform gas), so a run timed from
-//! the start reports more collisions per second than the engine sustains. The criterion
+//! the start reports more collisions per second than the engine sustains. `SEARCH` is how
+//! partners are found: `auto` (the engine's choice, default), `lists` (neighbour lists)
+//! or `cells` (cell lists with crossing events). The criterion
 //! bench `benches/event.rs` measures the same scenes with statistics; this example is
 //! the quick look.
 
@@ -19,7 +22,7 @@ use std::time::Instant;
 
 use carom_sim::plan::{BroadChoice, Plan};
 use carom_sim::scenes::gas::{GasParams, gas};
-use carom_sim::{BallStates, EngineKind, EventEngine, Simulation};
+use carom_sim::{BallStates, EngineKind, EventEngine, PairSearch, Simulation};
 use carom_toi::Direction;
 
 fn arg<T: std::str::FromStr>(k: usize, default: T) -> T {
@@ -37,6 +40,12 @@ fn main() {
         arg(4, 1.0),
         arg(5, 2.0),
     );
+    let search = match arg(6, "auto".to_owned()).as_str() {
+        "auto" => PairSearch::Auto,
+        "lists" => PairSearch::NeighbourLists,
+        "cells" => PairSearch::CellLists,
+        other => panic!("argument 6: `{other}` is not one of auto, lists, cells"),
+    };
     let params = GasParams {
         n,
         fraction,
@@ -54,7 +63,8 @@ fn main() {
         ($d:literal) => {{
             let scene = gas::<$d>(&params).unwrap_or_else(|e| panic!("{e}"));
             let start = Instant::now();
-            let mut sim = EventEngine::new(&scene, &plan, Direction::Forward).expect("a valid gas");
+            let mut sim = EventEngine::with_pair_search(&scene, &plan, Direction::Forward, search)
+                .expect("a valid gas");
             let setup = start.elapsed().as_secs_f64();
             let mut st = BallStates::default();
             sim.states(&mut st);
@@ -68,8 +78,9 @@ fn main() {
             let e1 = carom_sim::observe::energy(&scene, &st);
             let collisions = sim.counters().ball_ball - before;
             println!(
-                "{}D N = {n}, fraction {fraction}: setup {setup:.3} s; after {relax} untimed time units, {collisions} collisions in {wall:.3} s = {:.3} M/s; energy drift {:.1e}",
+                "{}D N = {n}, fraction {fraction} ({}): setup {setup:.3} s; after {relax} untimed time units, {collisions} collisions in {wall:.3} s = {:.3} M/s; energy drift {:.1e}",
                 $d,
+                sim.pipeline()[1],
                 collisions as f64 / wall / 1e6,
                 (e1 - e0) / e0
             );

@@ -26,4 +26,4 @@ pub use build::build;
 pub use engine::{
     Angular, BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation,
 };
-pub use event::EventEngine;
+pub use event::{EventEngine, PairSearch};

@@ -31,6 +31,12 @@ where
         if i >= self.balls.len() {
             return self.handle_cluster(i - self.balls.len(), observer);
         }
+        if let Partners::Cells(cells) = &self.partners
+            && let Some((axis, upper)) = cells.crossing_due(i)
+        {
+            self.cross(i, axis, upper);
+            return Ok(());
+        }
         match self.pending[i] {
             Pending::None => {}
             Pending::Recheck => self.predict(i),

@@ -25,6 +25,7 @@
 //! velocities with their sign flipped.
 
 pub mod calendar;
+pub mod cells;
 mod cluster;
 mod handle;
 pub mod neighbours;
@@ -43,6 +44,7 @@ use crate::plan::{BroadChoice, Plan};
 use crate::prefetch::prefetch;
 use crate::scene::{Inelastic, Scene, SceneError};
 use calendar::Calendar;
+use cells::CellLists;
 use cluster::ClusterBody;
 use neighbours::{Domain, NeighbourLists};
 use state::{Balls, Mode, Motion, Props, Support};
@@ -60,6 +62,10 @@ pub const ALL_PAIRS_MAX_BALLS: usize = 32;
 pub const LIST_PARTNERS_2D: f64 = 10.0;
 /// As [`LIST_PARTNERS_2D`], in 3D.
 pub const LIST_PARTNERS_3D: f64 = 10.0;
+
+/// Cell lists are chosen (`PairSearch::Auto`) when a prediction would read at most this
+/// many other balls from the cells around a ball on average; above it, neighbour lists.
+pub const CELL_CANDIDATES_MAX: f64 = 12.0;
 
 /// Consecutive events at one instant allowed per ball before the run is declared stuck
 /// (a Newton's cradle of `n` balls takes `n` events at one instant).
@@ -89,10 +95,68 @@ impl<T: Real, const D: usize> BoxBody<T, D> {
 /// How a ball finds its possible partners.
 #[derive(Clone, Debug)]
 pub(crate) enum Partners<T: Real, const D: usize> {
-    /// Every other ball.
-    All,
+    /// Every other ball. In a periodic box a pair is predicted with its minimum image at
+    /// the time of the prediction, which stays the image the pair can meet in only while
+    /// their separation changes by less than `L_min / 2 − 2 r_max`: each ball is
+    /// predicted again (`Pending::Recheck`) once it has moved `roam`, a third of that,
+    /// from where it was predicted (`None` without a periodic box). Since the pair's
+    /// latest prediction (by one of them) that one has moved less than `roam`, the other
+    /// less than `2 roam` (`roam` from its own, earlier, prediction point, which the
+    /// first's prediction time lies within).
+    All { roam: Option<T> },
     /// Symmetric neighbour lists with a shell.
     Lists(NeighbourLists<T, D>),
+    /// The balls of the cells around the ball's, cells changed at crossing events.
+    Cells(CellLists<T, D>),
+}
+
+impl<T: Real, const D: usize> Partners<T, D> {
+    /// Asks for what ball `i`'s next prediction reads first (its list or its cells'
+    /// rows) to be brought into the cache.
+    #[inline]
+    fn prefetch(&self, i: usize) {
+        match self {
+            Self::All { .. } => {}
+            Self::Lists(lists) => lists.prefetch(i),
+            Self::Cells(cells) => cells.prefetch(i),
+        }
+    }
+
+    /// Calls `f` with each possible partner of ball `i` (and perhaps `i` itself): every
+    /// ball with [`Partners::All`] only if `all` (a read-ahead has no use for them).
+    #[inline]
+    fn for_each(&self, i: usize, n: usize, all: bool, mut f: impl FnMut(usize)) {
+        match self {
+            Self::All { .. } => {
+                if all {
+                    (0..n).for_each(f);
+                }
+            }
+            Self::Lists(lists) => lists.partners(i).for_each(|j| f(j as usize)),
+            Self::Cells(cells) => cells.for_each_near(i, f),
+        }
+    }
+}
+
+/// How the event-driven engine finds the possible partners of a ball
+/// ([`EventEngine::with_pair_search`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PairSearch {
+    /// From the scene: every pair for at most [`ALL_PAIRS_MAX_BALLS`] balls (or
+    /// `--broad brute`); otherwise cell lists where they read fewer candidates per
+    /// prediction than a neighbour list holds, neighbour lists elsewhere.
+    #[default]
+    Auto,
+    /// Every pair.
+    AllPairs,
+    /// Symmetric neighbour lists with a shell (module [`neighbours`]); a periodic box must
+    /// be longer than four times a ball's reach `r_max + δ` on every axis.
+    NeighbourLists,
+    /// Cell lists with crossing events (module [`cells`]). They need a walled or
+    /// periodic border, and a periodic box at least five cells (ten diameters) long on
+    /// every axis; otherwise neighbour lists are used, or every pair in a periodic box
+    /// too small for lists.
+    CellLists,
 }
 
 /// What a ball's pending event is.
@@ -112,7 +176,9 @@ pub(crate) enum Pending {
     LeaveSupport,
     /// A contact with stuck cluster `c`, valid while the cluster's count is `count`.
     Cluster { c: u32, count: u32 },
-    /// Conservative advancement proved no contact only up to this time: predict again.
+    /// Predict again: conservative advancement proved no contact only up to this time,
+    /// or (every pair in a periodic box) the ball has moved as far as the minimum images
+    /// it was predicted with stay right.
     Recheck,
 }
 
@@ -167,6 +233,20 @@ where
     /// cannot run exactly: drag, stick clusters in 3D, a periodic box too small for the
     /// neighbour lists.
     pub fn new(scene: &Scene<T, D>, plan: &Plan, direction: Direction) -> Result<Self, SceneError> {
+        Self::with_pair_search(scene, plan, direction, PairSearch::Auto)
+    }
+
+    /// As [`EventEngine::new`], with the way partners are found chosen by the caller
+    /// (`Auto` is what `new` does). The choice changes the speed, not the physics.
+    ///
+    /// # Errors
+    /// As [`EventEngine::new`].
+    pub fn with_pair_search(
+        scene: &Scene<T, D>,
+        plan: &Plan,
+        direction: Direction,
+        search: PairSearch,
+    ) -> Result<Self, SceneError> {
         scene.validate()?;
         if let Some(why) = crate::plan::event_engine_limitation(scene) {
             return Err(SceneError::new(
@@ -206,7 +286,7 @@ where
             Some(b) => (Some(b.border), b.restitution, b.periodic),
             None => (None, T::one(), false),
         };
-        let partners = partners_for(scene, plan, &balls)?;
+        let partners = partners_for(scene, plan, search, &balls)?;
         let (collapse, resting) = guards(scene, &balls)?;
         // Stuck clusters take the calendar slots after the balls (at most n − 1 of them).
         let slots = if scene.world.inelastic == Inelastic::Stick {
@@ -283,8 +363,9 @@ where
     fn describe(&self, scene: &Scene<T, D>) -> Vec<String> {
         let mut p = vec!["event-driven".to_owned()];
         p.push(match &self.partners {
-            Partners::All => "pairs:all".to_owned(),
+            Partners::All { .. } => "pairs:all".to_owned(),
             Partners::Lists(_) => "pairs:neighbour-lists(grid)".to_owned(),
+            Partners::Cells(_) => "pairs:cell-lists(crossings)".to_owned(),
         });
         p.push("calendar:buckets+heap".to_owned());
         if self.balls.len() > 1 {
@@ -344,20 +425,27 @@ where
     }
 
     /// Prefetches what the next events will read (see `crate::prefetch`): for the balls
-    /// at the top of the calendar, their pending event, state and neighbour list, while
-    /// the current event is handled (their first reads were the largest stalls in a
-    /// profile; the measured gain is in `docs/event-engine.md`).
+    /// at the top of the calendar, their pending event and state, while the current
+    /// event is handled (their first reads were the largest stalls in a profile; the
+    /// measured gains are in `docs/event-engine.md`).
+    ///
+    /// With neighbour lists it also asks for the upcoming balls' lists and the states of
+    /// the partners the next predictions will read. With cell lists it does not: those
+    /// reads (nine cell rows per ball in 2D, and their balls) are many, and asking for
+    /// them all filled the core's queue of outstanding misses, so that the prefetches
+    /// themselves stalled (measured: 2D 0.62 M/s with them, 0.73 without).
     fn prefetch_upcoming(&self, current: usize) {
         let n = self.balls.len();
+        let lists = matches!(self.partners, Partners::Lists(_));
         // The states of the current collision's partner's partners: predicted after the
         // current ball's (its list was asked for at the previous event).
-        if current < n
-            && let (Pending::Ball { j, .. }, Partners::Lists(lists)) =
-                (self.pending[current], &self.partners)
+        if lists
+            && current < n
+            && let Pending::Ball { j, .. } = self.pending[current]
         {
-            for p in lists.partners(j as usize) {
-                prefetch(&self.balls.motion[p as usize]);
-            }
+            self.partners.for_each(j as usize, n, false, |p| {
+                prefetch(&self.balls.motion[p]);
+            });
         }
         for &b in self.calendar.upcoming(3) {
             let b = b as usize;
@@ -367,30 +455,41 @@ where
             prefetch(&self.pending[b]);
             prefetch(&self.balls.motion[b]);
             prefetch(&self.balls.props[b]);
-            if let Partners::Lists(lists) = &self.partners {
-                lists.prefetch(b);
+            match &self.partners {
+                Partners::Lists(lists) => lists.prefetch(b),
+                Partners::Cells(cells) => cells.prefetch_place(b),
+                Partners::All { .. } => {}
             }
         }
-        // The next event's partner, and the states of the next ball's partners (its
+        // The next collision's partner, and the states of the next ball's partners (its
         // pending event and list were asked for at the previous event, most likely).
         if let Some(&b) = self.calendar.upcoming(1).first()
             && (b as usize) < n
         {
             let b = b as usize;
-            if let Pending::Ball { j, .. } = self.pending[b] {
-                let j = j as usize;
+            if let Some(j) = self.due_partner(b) {
                 prefetch(&self.balls.motion[j]);
                 prefetch(&self.balls.props[j]);
                 prefetch(&self.balls.count[j]);
-                if let Partners::Lists(lists) = &self.partners {
-                    lists.prefetch(j);
-                }
+                self.partners.prefetch(j);
             }
-            if let Partners::Lists(lists) = &self.partners {
-                for p in lists.partners(b) {
-                    prefetch(&self.balls.motion[p as usize]);
-                }
+            if lists {
+                self.partners.for_each(b, n, false, |p| {
+                    prefetch(&self.balls.motion[p]);
+                });
             }
+        }
+    }
+
+    /// The partner of ball `b`'s collision, if a collision is what comes due for it next
+    /// (with cell lists, a crossing may come first).
+    fn due_partner(&self, b: usize) -> Option<usize> {
+        match (&self.partners, self.pending[b]) {
+            (Partners::Cells(cells), Pending::Ball { .. }) if cells.crossing_due(b).is_some() => {
+                None
+            }
+            (_, Pending::Ball { j, .. }) => Some(j as usize),
+            _ => None,
         }
     }
 
@@ -548,11 +647,15 @@ fn length_scale<T: Real, const D: usize>(scene: &Scene<T, D>) -> T {
     spread.max(border).max(T::MIN_POSITIVE.sqrt())
 }
 
-/// Neighbour lists for more than a handful of balls (or when asked), every pair
-/// otherwise; checks that a periodic box is large enough for the minimum image.
+/// The way partners are found (see [`PairSearch`]): every pair when asked or for a
+/// handful of balls; otherwise cell lists if asked or if they read few candidates (and
+/// a periodic box has the cells for them), else neighbour lists if a periodic box is
+/// long enough for their reach (an error if they were asked for and it is not), else
+/// every pair. A periodic box must at least be longer than two diameters.
 fn partners_for<T: Real, const D: usize>(
     scene: &Scene<T, D>,
     plan: &Plan,
+    search: PairSearch,
     balls: &Balls<T, D>,
 ) -> Result<Partners<T, D>, SceneError>
 where
@@ -565,46 +668,88 @@ where
         .map(|m| m.radius)
         .fold(T::zero(), T::max);
     let shell = list_shell(scene, balls);
-    if let Some(b) = scene.world.border.filter(|b| b.periodic).map(|b| b.border) {
-        // The minimum image is the only image within reach when every period is longer
-        // than twice the longest reach between two anchors.
-        let reach = (r_max + shell) * T::lit(2.0);
-        if let Some(k) = (0..D).find(|&k| b.extents()[k] <= reach * T::lit(2.0)) {
-            return Err(SceneError::new(
-                "world.border",
-                format!(
-                    "a periodic box must be longer than {} on every axis (axis {k} is {})",
-                    reach * T::lit(2.0),
-                    b.extents()[k]
-                ),
-            ));
+    let search = match (search, plan.broad) {
+        (PairSearch::Auto, BroadChoice::Brute) => PairSearch::AllPairs,
+        (PairSearch::Auto, BroadChoice::Grid) => PairSearch::Auto,
+        (PairSearch::Auto, _) if n <= ALL_PAIRS_MAX_BALLS => PairSearch::AllPairs,
+        (search, _) => search,
+    };
+    let border = scene.world.border;
+    let period = border.filter(|b| b.periodic).map(|b| b.border);
+    // Lists' partners are up to `2 (r_max + δ)` apart: the minimum image is theirs
+    // when every period is longer than twice that.
+    let lists_fit = period.is_none_or(|b| check_period(&b, (r_max + shell) * T::lit(2.0)).is_ok());
+    if n >= 2 && search != PairSearch::AllPairs {
+        let positions: Vec<Vector<T, D>> = balls.motion.iter().map(|m| m.pos).collect();
+        if let Some(b) = border
+            && search != PairSearch::NeighbourLists
+        {
+            let cells = CellLists::new(
+                &positions,
+                r_max,
+                b.border.min(),
+                b.border.max(),
+                b.periodic,
+            );
+            let fewer = cells.candidates_per_prediction(n) <= T::lit(CELL_CANDIDATES_MAX);
+            if cells.images_are_unique() && (search == PairSearch::CellLists || fewer) {
+                return Ok(Partners::Cells(cells));
+            }
+        }
+        if lists_fit || search == PairSearch::NeighbourLists {
+            if let Some(b) = &period {
+                check_period(b, (r_max + shell) * T::lit(2.0))?;
+            }
+            let domain = match &border {
+                Some(b) if b.periodic => Domain::Periodic {
+                    min: b.border.min(),
+                    max: b.border.max(),
+                },
+                Some(b) => Domain::Bounded {
+                    min: b.border.min(),
+                    max: b.border.max(),
+                },
+                None => Domain::Unbounded,
+            };
+            return Ok(Partners::Lists(NeighbourLists::new(
+                &positions,
+                &balls.motion.iter().map(|m| m.radius).collect::<Vec<_>>(),
+                shell,
+                domain,
+            )));
         }
     }
-    let use_lists = match plan.broad {
-        BroadChoice::Brute => false,
-        BroadChoice::Grid => true,
-        _ => n > ALL_PAIRS_MAX_BALLS,
+    // Every pair: asked for, a handful of balls, or a periodic box too small for cells
+    // and lists.
+    let roam = match period {
+        Some(b) => {
+            // Contact must be closer than half a period, with room to move.
+            check_period(&b, r_max * T::lit(2.0))?;
+            let half = b.extents().min() * T::lit(0.5);
+            Some((half - r_max * T::lit(2.0)) / T::lit(3.0))
+        }
+        None => None,
     };
-    if !use_lists || n < 2 {
-        return Ok(Partners::All);
+    Ok(Partners::All { roam })
+}
+
+/// A periodic box whose every period is longer than twice `reach` (the longest
+/// separation at which two balls are tested), or the error naming the short axis.
+fn check_period<T: Real, const D: usize>(
+    border: &Border<T, D>,
+    reach: T,
+) -> Result<(), SceneError> {
+    match (0..D).find(|&k| border.extents()[k] <= reach * T::lit(2.0)) {
+        Some(k) => Err(SceneError::new(
+            "world.border",
+            format!(
+                "a periodic box must be longer than {} on every axis (axis {k} is {})",
+                reach * T::lit(2.0),
+                border.extents()[k]
+            ),
+        )),
+        None => Ok(()),
     }
-    let domain = match &scene.world.border {
-        Some(b) if b.periodic => Domain::Periodic {
-            min: b.border.min(),
-            max: b.border.max(),
-        },
-        Some(b) => Domain::Bounded {
-            min: b.border.min(),
-            max: b.border.max(),
-        },
-        None => Domain::Unbounded,
-    };
-    Ok(Partners::Lists(NeighbourLists::new(
-        &balls.motion.iter().map(|m| m.pos).collect::<Vec<_>>(),
-        &balls.motion.iter().map(|m| m.radius).collect::<Vec<_>>(),
-        shell,
-        domain,
-    )))
 }
 
 /// The shell `δ` whose lists hold about [`LIST_PARTNERS_2D`] (3D: [`LIST_PARTNERS_3D`])

@@ -37,13 +37,50 @@ where
         if !self.clusters.is_empty() {
             self.predict_ball_vs_clusters(i, &mut best.time, &mut best.pending);
         }
-        self.offer_partners(i, &ball, &kin, &mut best);
+        self.offer_partners(i, &ball, &kin, &mut best, Near::Around);
         self.pending[i] = best.pending;
-        self.calendar.schedule(i, best.time);
+        self.schedule(i, &ball, &kin, best.time);
     }
 
-    /// The events of ball `i` alone: leaving its neighbour-list shell, sliding off the
-    /// face it rests on.
+    /// Schedules ball `i`, whose pending event is due at `event`: with cell lists, at the
+    /// earlier of that and its next crossing of a face of its cell.
+    fn schedule(&mut self, i: usize, ball: &Ball<T, D>, kin: &Kinematics<T, D>, event: T) {
+        let time = match &mut self.partners {
+            Partners::Cells(cells) => {
+                let crossing =
+                    cells.next_crossing(i, &ball.center(), &kin.velocity(), &kin.acceleration());
+                cells.record(i, self.now, event, crossing)
+            }
+            _ => event,
+        };
+        self.calendar.schedule(i, time);
+    }
+
+    /// Ball `i` crosses the face (`axis`, `upper`) of its cell (cell lists): it moves to
+    /// the cell across, and is predicted against the balls of the cells its neighbourhood
+    /// gains. Its pending event stays: it was the earliest against every other candidate,
+    /// and the new ones are searched up to it. (A stale pending event is kept too: when it
+    /// comes due, the ball is predicted afresh.)
+    pub(crate) fn cross(&mut self, i: usize, axis: usize, upper: bool) {
+        let Partners::Cells(cells) = &mut self.partners else {
+            return;
+        };
+        cells.cross(i, axis, upper);
+        let mut best = Best {
+            time: cells.event_time(i),
+            pending: self.pending[i],
+        };
+        let ball = self.ball_at(i, self.now);
+        let kin =
+            Kinematics::new_unchecked(self.balls.velocity_at(i, self.now), self.balls.accel(i));
+        self.offer_partners(i, &ball, &kin, &mut best, Near::Entering { axis, upper });
+        self.pending[i] = best.pending;
+        self.schedule(i, &ball, &kin, best.time);
+    }
+
+    /// The events of ball `i` alone: leaving its neighbour-list shell (or, pairing with
+    /// every ball in a periodic box, moving far enough to need another image), sliding off
+    /// the face it rests on.
     fn own_event(&self, i: usize) -> Best<T> {
         let now = self.now;
         let mut best = Best {
@@ -60,6 +97,15 @@ where
                 lists.shell() * T::lit(SHELL_SAFETY),
             );
             best.offer(now + s, Pending::Rebuild);
+        }
+        if let Partners::All { roam: Some(roam) } = &self.partners {
+            let s = exit_time(
+                &Vector::zeros(),
+                &self.balls.velocity_at(i, now),
+                &self.balls.accel(i),
+                *roam,
+            );
+            best.offer(now + s, Pending::Recheck);
         }
         if let Some(Support::BoxFace { k, axis, .. }) = self.support_of(i)
             && let Some(s) = self.face_exit_time(i, k, axis)
@@ -109,13 +155,14 @@ where
         }
     }
 
-    /// The first collision of ball `i` with each of its partners.
+    /// The first collision of ball `i` with each of its partners `near` it.
     fn offer_partners(
         &self,
         i: usize,
         ball: &Ball<T, D>,
         kin: &Kinematics<T, D>,
         best: &mut Best<T>,
+        near: Near,
     ) {
         let now = self.now;
         let periodic = self.periodic_border();
@@ -142,9 +189,13 @@ where
                 );
             }
         };
-        match &self.partners {
-            Partners::All => (0..self.balls.len()).for_each(&mut consider),
-            Partners::Lists(lists) => lists.partners(i).for_each(|j| consider(j as usize)),
+        match (near, &self.partners) {
+            (Near::Entering { axis, upper }, Partners::Cells(cells)) => {
+                cells.for_each_entering(i, axis, upper, &mut consider);
+            }
+            _ => self
+                .partners
+                .for_each(i, self.balls.len(), true, &mut consider),
         }
     }
 
@@ -174,6 +225,16 @@ where
         }
         first
     }
+}
+
+/// Which partners a prediction searches.
+#[derive(Clone, Copy, Debug)]
+enum Near {
+    /// All of them.
+    Around,
+    /// Those a ball's neighbourhood gained when it crossed the face (`axis`, `upper`)
+    /// into its cell (cell lists).
+    Entering { axis: usize, upper: bool },
 }
 
 /// The earliest candidate event so far; later searches use its time as their horizon.

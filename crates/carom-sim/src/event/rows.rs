@@ -19,28 +19,42 @@
 
 use crate::prefetch::prefetch;
 
-/// A list's length and its first `W` ids.
+/// Rows aligned to the cache line (64 bytes): a row is read with one miss.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
-struct Row<const W: usize> {
+#[repr(align(64))]
+pub(crate) struct Line;
+
+/// Rows aligned to 16 bytes, for rows of 3 ids read several at a time from one line
+/// (the cells of a grid row, next to each other in memory).
+#[derive(Clone, Copy, Debug)]
+#[repr(align(16))]
+pub(crate) struct Quarter;
+
+/// A list's length and its first `W` ids, aligned as `A`.
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+struct Row<const W: usize, A> {
+    align: [A; 0],
     len: u32,
     ids: [u32; W],
 }
 
-/// `n` lists of ids, the first `W` of each in its row (see the module documentation).
+/// `n` lists of ids, the first `W` of each in its row, rows aligned as `A` (see the
+/// module documentation).
 #[derive(Clone, Debug)]
-pub(crate) struct IdRows<const W: usize> {
-    rows: Vec<Row<W>>,
+pub(crate) struct IdRows<const W: usize, A = Line> {
+    rows: Vec<Row<W, A>>,
     /// The ids beyond the row, per list (empty, never allocated, for most).
     spill: Vec<Vec<u32>>,
 }
 
-impl<const W: usize> IdRows<W> {
+impl<const W: usize, A: Copy> IdRows<W, A> {
     /// `n` empty lists.
     pub(crate) fn new(n: usize) -> Self {
         Self {
             rows: vec![
                 Row {
+                    align: [],
                     len: 0,
                     ids: [0; W]
                 };
@@ -216,8 +230,11 @@ mod tests {
 
     #[test]
     fn rows_of_15_and_31_ids_are_one_and_two_cache_lines_aligned_to_one() {
-        assert_eq!(core::mem::size_of::<Row<31>>(), 128);
-        assert_eq!(core::mem::size_of::<Row<15>>(), 64);
-        assert_eq!(core::mem::align_of::<Row<15>>(), 64);
+        assert_eq!(core::mem::size_of::<Row<31, Line>>(), 128);
+        assert_eq!(core::mem::size_of::<Row<15, Line>>(), 64);
+        assert_eq!(core::mem::align_of::<Row<15, Line>>(), 64);
+        // Four rows of 3 ids share a line.
+        assert_eq!(core::mem::size_of::<Row<3, Quarter>>(), 16);
+        assert_eq!(core::mem::align_of::<Row<3, Quarter>>(), 16);
     }
 }
