@@ -43,8 +43,12 @@ const CELL_ROW: usize = 3;
 const MAX_AROUND: usize = 27;
 /// The fewest cells per axis of a periodic box (see [`CellLists::images_are_unique`]).
 pub const MIN_PERIODIC_CELLS: i64 = 5;
-/// The relative margin by which a cell is wider than the largest diameter.
+/// The relative margin by which a cell is wider than the largest diameter, at least (see
+/// `CellLists::new` for the precision-dependent part).
 const CELL_MARGIN: f64 = 1e-6;
+/// How far inside an open face a ball's offset is clamped before its crossing is
+/// computed, relative to the cell width, at least (and at least 16 ulps).
+const FACE_INSET: f64 = 1e-9;
 
 /// A ball's cell and its two scheduled times: its next crossing of a face of the cell
 /// and its next other event (the engine's calendar holds the earlier of the two).
@@ -92,7 +96,10 @@ pub struct CellLists<T: Real, const D: usize> {
 impl<T: Real, const D: usize> CellLists<T, D> {
     /// Cells over the box `[min, max]` (periodic or walled) for balls at `positions`, the
     /// largest of radius `r_max`. Cells are at least `2 r_max (1 + margin)` wide, and
-    /// widened where a sparse box would need more than about `4 n` of them.
+    /// widened where a sparse box would need more than about `4 n` of them. The margin
+    /// is `10⁻⁶`, or more where the coordinates' rounding (`256 ε` of the box's largest
+    /// coordinate, a diameter's worth of which in `f32` is a hundred times that) could
+    /// reach it.
     pub fn new(
         positions: &[Vector<T, D>],
         r_max: T,
@@ -104,7 +111,10 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         let ext = max - min;
         let budget = T::from_count((4 * n).max(64));
         let needed = (ext.product() / budget).powf(T::one() / T::from_count(D));
-        let cell = (r_max * T::lit(2.0 * (1.0 + CELL_MARGIN))).max(needed);
+        let reach = min.amax().max(max.amax());
+        let rounding = T::lit(256.0) * T::EPSILON * reach / (r_max * T::lit(2.0));
+        let margin = rounding.max(T::lit(CELL_MARGIN));
+        let cell = (r_max * T::lit(2.0) * (T::one() + margin)).max(needed);
         let counts: [i64; D] =
             core::array::from_fn(|k| ((ext[k] / cell).floor().to_f64() as i64).max(1));
         let width = Vector::<T, D>::from_fn(|k, _| ext[k] / T::from_count(counts[k] as usize));
@@ -260,7 +270,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
     /// it never does.
     ///
     /// Where a face is open, the ball's offset from it is first clamped to at least
-    /// `10⁻⁹ w` inside: a ball that rounding left just past the face it last crossed, or
+    /// `10⁻⁹ w` (16 ulps in `f32`) inside: a ball that rounding left just past the face it last crossed, or
     /// just short of it, is then always crossing outwards from inside, never twice at
     /// one instant (the clamp moves the crossing by far less than the cells' margin).
     pub(crate) fn next_crossing(
@@ -281,7 +291,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         let mut first: Option<Crossing<T>> = None;
         for k in 0..D {
             let w = self.width[k];
-            let inset = w * T::lit(1e-9);
+            let inset = w * T::lit(FACE_INSET).max(T::lit(16.0) * T::EPSILON);
             let lower_open = periodic || c[k] > 0;
             let upper_open = periodic || c[k] + 1 < self.counts[k];
             let mut x = offset[k];
