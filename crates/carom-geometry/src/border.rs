@@ -128,16 +128,48 @@ impl<T: Real, const D: usize> Border<T, D> {
     }
 
     /// The minimum image of the separation `delta` in a periodic border: each
-    /// component shifted by a whole number of periods into `[−L/2, L/2]`.
+    /// component shifted by a whole number of periods into `[−L/2, L/2]` (see
+    /// [`Period::minimum_image`]).
+    #[inline]
+    pub fn minimum_image(&self, delta: &Vector<T, D>) -> Vector<T, D> {
+        self.period().minimum_image(delta)
+    }
+
+    /// The periods of the border taken as periodic, for many minimum images.
+    #[inline]
+    pub fn period(&self) -> Period<T, D> {
+        let length = self.extents();
+        Period {
+            length,
+            half: length * T::lit(0.5),
+        }
+    }
+}
+
+/// The periods of a periodic border and their halves: what a minimum image reads,
+/// computed once ([`Border::period`]) for code that takes many.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Period<T: Real, const D: usize> {
+    length: Vector<T, D>,
+    half: Vector<T, D>,
+}
+
+impl<T: Real, const D: usize> Period<T, D> {
+    /// The periods (the border's edge lengths).
+    #[inline]
+    pub fn length(&self) -> &Vector<T, D> {
+        &self.length
+    }
+
+    /// The minimum image of the separation `delta`: each component shifted by a whole
+    /// number of periods into `[−L/2, L/2]`.
     ///
     /// Separations of points inside the box are within one period, and are shifted with
     /// a comparison; only larger ones use `round`.
     #[inline]
     pub fn minimum_image(&self, delta: &Vector<T, D>) -> Vector<T, D> {
-        let len = self.extents();
         Vector::<T, D>::from_fn(|i, _| {
-            let (d, l) = (delta[i], len[i]);
-            let h = l * T::lit(0.5);
+            let (d, l, h) = (delta[i], self.length[i], self.half[i]);
             // For d > L/2, d − L > −L/2 always; it is the image if also d − L <= L/2.
             if d > h {
                 if d - l <= h {

@@ -30,7 +30,7 @@ pub mod query;
 
 pub use aabb::Aabb;
 pub use ball::Ball;
-pub use border::Border;
+pub use border::{Border, Period};
 pub use bounding_volume::{BoundingSphere, BoundingVolume};
 pub use carom_math::{InvalidValue, Problem, Real, Rotation, Space, Vector};
 pub use half_space::HalfSpace;

@@ -32,6 +32,7 @@ use carom_geometry::Border;
 use carom_math::{Real, Vector, floor_to_i64};
 use carom_toi::{Direction, Window, level_crossing};
 
+use super::grid::{GridIndex, MAX_AROUND};
 use super::rows::{IdRows, Quarter};
 use crate::prefetch::prefetch;
 
@@ -39,8 +40,6 @@ use crate::prefetch::prefetch;
 /// of a grid row around a ball are one or two lines. At the widths used a cell holds
 /// about 0.4 equal balls in 2D at area fraction 0.3 (at most 4; 8 in 3D); more spill.
 const CELL_ROW: usize = 3;
-/// The most cells around a ball (`3^D` for `D <= 3`).
-const MAX_AROUND: usize = 27;
 /// The fewest cells per axis of a periodic box (see [`CellLists::images_are_unique`]).
 pub const MIN_PERIODIC_CELLS: i64 = 5;
 /// The relative margin by which a cell is wider than the largest diameter, at least (see
@@ -82,15 +81,14 @@ pub struct CellLists<T: Real, const D: usize> {
     origin: Vector<T, D>,
     /// The width of the cells per axis (each axis is cut into whole cells).
     width: Vector<T, D>,
-    counts: [i64; D],
+    /// The grid's shape: cells per axis, neighbourhoods.
+    grid: GridIndex<D>,
     /// The periodic box, for minimum images and wrapping cell coordinates.
     period: Option<Border<T, D>>,
     /// The balls in each cell.
     members: IdRows<CELL_ROW, Quarter>,
     /// Each ball's cell and scheduled times.
     places: Vec<Place<T, D>>,
-    /// The index offsets of the `3^D` cells around an interior cell.
-    offsets: [i64; MAX_AROUND],
 }
 
 impl<T: Real, const D: usize> CellLists<T, D> {
@@ -118,27 +116,15 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         let counts: [i64; D] =
             core::array::from_fn(|k| ((ext[k] / cell).floor().to_f64() as i64).max(1));
         let width = Vector::<T, D>::from_fn(|k, _| ext[k] / T::from_count(counts[k] as usize));
-        let total: i64 = counts.iter().product();
+        let grid = GridIndex::new(counts, periodic);
         let mut cells = Self {
             origin: min,
             width,
-            counts,
+            members: IdRows::new(grid.len()),
+            grid,
             period: periodic.then(|| Border::new(min, max).expect("a periodic box is a valid box")),
-            members: IdRows::new(total as usize),
             places: Vec::with_capacity(n),
-            offsets: [0; MAX_AROUND],
         };
-        for offset in 0..3usize.pow(D as u32) {
-            let mut rest = offset;
-            let mut delta = 0i64;
-            let mut stride = 1i64;
-            for count in counts {
-                delta += ((rest % 3) as i64 - 1) * stride;
-                rest /= 3;
-                stride *= count;
-            }
-            cells.offsets[offset] = delta;
-        }
         for (i, p) in positions.iter().enumerate() {
             let c: [i64; D] = core::array::from_fn(|k| {
                 let c = floor_to_i64((p[k] - min[k]) / width[k]);
@@ -148,7 +134,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
                     c.clamp(0, counts[k] - 1)
                 }
             });
-            cells.members.push(cells.index(c), i as u32);
+            cells.members.push(cells.grid.index(c), i as u32);
             cells.places.push(Place {
                 cell: c.map(|x| x as i32),
                 crossing: T::INFINITY,
@@ -173,58 +159,14 @@ impl<T: Real, const D: usize> CellLists<T, D> {
     /// (plus the margin), and the minimum image is then theirs only if every period is
     /// longer than four widths: with five cells or more it is, with margin to spare.
     pub fn images_are_unique(&self) -> bool {
-        self.period.is_none() || self.counts.iter().all(|&c| c >= MIN_PERIODIC_CELLS)
-    }
-
-    /// The linear index of the cell with (in-grid) coordinates `c`.
-    #[inline]
-    fn index(&self, c: [i64; D]) -> usize {
-        let mut index = 0i64;
-        for k in (0..D).rev() {
-            index = index * self.counts[k] + c[k];
-        }
-        index as usize
+        self.period.is_none() || self.grid.counts().iter().all(|&c| c >= MIN_PERIODIC_CELLS)
     }
 
     /// The cells around ball `i`'s (its own and its neighbours, each once) written to the
     /// start of `around`; returns their number.
     #[inline]
     fn around(&self, i: usize, around: &mut [usize; MAX_AROUND]) -> usize {
-        let base = self.cell(i);
-        let cells = 3usize.pow(D as u32);
-        // An interior cell's neighbours are at fixed index offsets, all distinct.
-        if (0..D).all(|k| base[k] >= 1 && base[k] + 2 <= self.counts[k]) {
-            let index = self.index(base) as i64;
-            for (slot, delta) in around.iter_mut().zip(&self.offsets[..cells]) {
-                *slot = (index + delta) as usize;
-            }
-            return cells;
-        }
-        let periodic = self.period.is_some();
-        let mut count = 0;
-        'offsets: for offset in 0..cells {
-            let mut rest = offset;
-            let mut c = [0i64; D];
-            for (k, ck) in c.iter_mut().enumerate() {
-                let o = (rest % 3) as i64 - 1;
-                rest /= 3;
-                let mut x = base[k] + o;
-                let n = self.counts[k];
-                if x < 0 || x >= n {
-                    if !periodic {
-                        continue 'offsets;
-                    }
-                    x = x.rem_euclid(n);
-                }
-                *ck = x;
-            }
-            let index = self.index(c);
-            if !around[..count].contains(&index) {
-                around[count] = index;
-                count += 1;
-            }
-        }
-        count
+        self.grid.around(self.cell(i), around)
     }
 
     /// Calls `f` with every ball in the cells around ball `i`'s, `i` included.
@@ -293,7 +235,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
             let w = self.width[k];
             let inset = w * T::lit(FACE_INSET).max(T::lit(16.0) * T::EPSILON);
             let lower_open = periodic || c[k] > 0;
-            let upper_open = periodic || c[k] + 1 < self.counts[k];
+            let upper_open = periodic || c[k] + 1 < self.grid.counts()[k];
             let mut x = offset[k];
             if lower_open {
                 x = x.max(inset);
@@ -337,7 +279,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
     pub(crate) fn cross(&mut self, i: usize, axis: usize, upper: bool) {
         let from = self.cell(i);
         let mut to = from;
-        let n = self.counts[axis];
+        let n = self.grid.counts()[axis];
         to[axis] = if upper {
             from[axis] + 1
         } else {
@@ -348,7 +290,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         } else {
             to[axis] = to[axis].clamp(0, n - 1);
         }
-        let (a, b) = (self.index(from), self.index(to));
+        let (a, b) = (self.grid.index(from), self.grid.index(to));
         if a != b {
             self.members.remove(a, i as u32);
             self.members.push(b, i as u32);
@@ -382,7 +324,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
                     o
                 };
                 let mut x = base[k] + o;
-                let n = self.counts[k];
+                let n = self.grid.counts()[k];
                 if x < 0 || x >= n {
                     if !periodic {
                         continue 'offsets;
@@ -391,7 +333,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
                 }
                 *ck = x;
             }
-            let index = self.index(c);
+            let index = self.grid.index(c);
             if !seen[..count].contains(&index) {
                 seen[count] = index;
                 count += 1;
@@ -470,7 +412,7 @@ mod tests {
             .collect();
         let (lo, hi) = (Vector::zeros(), Vector::repeat(side));
         let mut cells = CellLists::new(&positions, 0.25, lo, hi, periodic);
-        assert_eq!(cells.counts, [counts as i64; D]);
+        assert_eq!(cells.grid.counts(), &[counts as i64; D]);
         let border = Border::new(lo, hi).unwrap();
         let mut p = positions[0];
         let mut crossings = 0;

@@ -27,13 +27,14 @@
 pub mod calendar;
 pub mod cells;
 mod cluster;
+mod grid;
 mod handle;
 pub mod neighbours;
 mod predict;
 mod rows;
 mod state;
 
-use carom_geometry::{Ball, Border, Obb};
+use carom_geometry::{Ball, Border, Obb, Period};
 use carom_math::{Real, Space, Vector};
 use carom_response::{CollapseGuard, RestingGuard};
 use carom_toi::Direction;
@@ -193,6 +194,8 @@ where
     border: Option<Border<T, D>>,
     border_restitution: T,
     periodic: bool,
+    /// The border's periods, when it is periodic.
+    period: Option<Period<T, D>>,
     boxes: Vec<BoxBody<T, D>>,
     world_restitution: T,
     stick: bool,
@@ -309,6 +312,7 @@ where
             border,
             border_restitution,
             periodic,
+            period: border.filter(|_| periodic).map(|b| b.period()),
             boxes,
             world_restitution: scene.world.restitution,
             stick: scene.world.inelastic == Inelastic::Stick,
@@ -418,8 +422,8 @@ where
     /// The separation `b − a` (minimum image in a periodic box).
     #[inline]
     pub(crate) fn separation(&self, a: &Vector<T, D>, b: &Vector<T, D>) -> Vector<T, D> {
-        match self.periodic_border() {
-            Some(border) => border.minimum_image(&(b - a)),
+        match &self.period {
+            Some(period) => period.minimum_image(&(b - a)),
             None => b - a,
         }
     }

@@ -20,9 +20,10 @@
 //! Very mixed radii make the cells (sized by the largest ball) hold many small balls;
 //! the lists stay exact, only rebuilds get slower.
 
-use carom_geometry::Border;
+use carom_geometry::{Border, Period};
 use carom_math::{Real, Vector, floor_to_i64};
 
+use super::grid::{GridIndex, MAX_AROUND};
 use super::rows::IdRows;
 use crate::prefetch::prefetch;
 
@@ -31,8 +32,6 @@ use crate::prefetch::prefetch;
 const CELL_ROW: usize = 15;
 /// Partners kept in a ball's row (128 bytes; the engine aims at 10 (2D) to 16 (3D)).
 const LIST_ROW: usize = 31;
-/// The most cells a rebuild looks at (`3^D` for `D <= 3`).
-const MAX_CELLS: usize = 27;
 
 /// A ball's anchor and radius, read together for each candidate of a rebuild.
 #[derive(Clone, Copy, Debug)]
@@ -65,11 +64,11 @@ pub enum Domain<T: Real, const D: usize> {
 /// How anchors map to cell heads.
 #[derive(Clone, Debug)]
 enum Cells<T: Real, const D: usize> {
-    /// Direct indexing into a `counts[0] × … × counts[D−1]` array.
+    /// Direct indexing into a grid over the box from `origin` (boxed: the grid's table
+    /// of neighbour offsets is large beside the hashed variant).
     Direct {
         origin: Vector<T, D>,
-        counts: [i64; D],
-        periodic: bool,
+        grid: Box<GridIndex<D>>,
     },
     /// Hashed integer coordinates into `heads.len()` (a power of two) buckets.
     Hashed,
@@ -82,8 +81,8 @@ pub struct NeighbourLists<T: Real, const D: usize> {
     /// Inverse cell width per axis (periodic axes are tiled exactly by their cells).
     inv_cell: Vector<T, D>,
     cells: Cells<T, D>,
-    /// The periodic box, for minimum images.
-    period: Option<Border<T, D>>,
+    /// The periods of a periodic box, for minimum images.
+    period: Option<Period<T, D>>,
     /// The balls anchored in each cell.
     members: IdRows<CELL_ROW>,
     /// The cell of each ball's anchor.
@@ -124,11 +123,13 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
                 (
                     Cells::Direct {
                         origin: min,
-                        counts,
-                        periodic,
+                        grid: Box::new(GridIndex::new(counts, periodic)),
                     },
-                    periodic
-                        .then(|| Border::new(min, max).expect("a periodic domain is a valid box")),
+                    periodic.then(|| {
+                        Border::new(min, max)
+                            .expect("a periodic domain is a valid box")
+                            .period()
+                    }),
                     total as usize,
                     width,
                 )
@@ -160,7 +161,7 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
             lists.members.push(c, i as u32);
             lists.cell_of[i] = c as u32;
         }
-        let mut around = [0; MAX_CELLS];
+        let mut around = [0; MAX_AROUND];
         for i in 0..n {
             let count = lists.cells_around(&lists.balls[i].anchor, &mut around);
             lists.collect_partners(i, &around[..count], true);
@@ -205,7 +206,7 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
     #[inline]
     pub fn separation(&self, a: &Vector<T, D>, b: &Vector<T, D>) -> Vector<T, D> {
         match &self.period {
-            Some(border) => border.minimum_image(&(b - a)),
+            Some(period) => period.minimum_image(&(b - a)),
             None => b - a,
         }
     }
@@ -215,7 +216,7 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
     pub fn rebuild(&mut self, i: usize, position: Vector<T, D>) {
         // The cells around the new anchor are read after the old partners' lists are
         // edited: asked for first, both sets of misses overlap.
-        let mut around = [0; MAX_CELLS];
+        let mut around = [0; MAX_AROUND];
         let count = self.cells_around(&position, &mut around);
         for &c in &around[..count] {
             self.members.prefetch(c);
@@ -236,8 +237,7 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
         // The candidates' anchors are misses of their own: asked for all at once first.
         self.candidates.clear();
         for &c in around {
-            for k in 0..self.members.len(c) {
-                let j = self.members.get(c, k);
+            for j in self.members.of(c) {
                 let ju = j as usize;
                 if ju != i && !(only_higher && ju < i) {
                     prefetch(&self.balls[ju]);
@@ -245,103 +245,79 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
                 }
             }
         }
-        let two = T::lit(2.0);
-        for k in 0..self.candidates.len() {
-            let j = self.candidates[k];
-            let ju = j as usize;
-            let other = &self.balls[ju];
-            let reach = radius + other.radius + two * self.shell;
-            if self.separation(&a, &other.anchor).norm_squared() < reach * reach {
+        let shells = self.shell * T::lit(2.0);
+        for &j in &self.candidates {
+            let other = &self.balls[j as usize];
+            let within = radius + other.radius + shells;
+            let d = other.anchor - a;
+            let d = match &self.period {
+                Some(period) => period.minimum_image(&d),
+                None => d,
+            };
+            if d.norm_squared() < within * within {
                 self.lists.push(i, j);
-                self.lists.push(ju, i as u32);
+                self.lists.push(j as usize, i as u32);
             }
         }
     }
 
     /// Writes the cells around the cell of `p` (its neighbours and itself, each once) to
     /// the start of `around`, and returns their number.
-    fn cells_around(&self, p: &Vector<T, D>, around: &mut [usize; MAX_CELLS]) -> usize {
+    fn cells_around(&self, p: &Vector<T, D>, around: &mut [usize; MAX_AROUND]) -> usize {
         let base = self.cell_coords(p);
-        let mut count = 0;
-        for offset in 0..3usize.pow(D as u32) {
-            if let Some(c) = self.index_of(Self::around(base, offset))
-                && !around[..count].contains(&c)
-            {
-                around[count] = c;
-                count += 1;
-            }
-        }
-        count
-    }
-
-    fn cell_coords(&self, p: &Vector<T, D>) -> [i64; D] {
-        let origin = match &self.cells {
-            Cells::Direct { origin, .. } => *origin,
-            Cells::Hashed => Vector::zeros(),
-        };
-        // Saturating casts keep far-away points finite. In a bounded domain the edge
-        // cells extend to infinity, so coordinates are clamped to the grid.
-        core::array::from_fn(|k| {
-            let c = floor_to_i64((p[k] - origin[k]) * self.inv_cell[k]);
-            match &self.cells {
-                Cells::Direct {
-                    counts,
-                    periodic: false,
-                    ..
-                } => c.clamp(0, counts[k] - 1),
-                _ => c,
-            }
-        })
-    }
-
-    /// The head index of the cell with integer coordinates `c`, or `None` outside a
-    /// bounded domain.
-    fn index_of(&self, c: [i64; D]) -> Option<usize> {
         match &self.cells {
-            Cells::Direct {
-                counts, periodic, ..
-            } => {
-                let mut index = 0i64;
-                for k in (0..D).rev() {
-                    let mut ck = c[k];
-                    let n = counts[k];
-                    // Neighbour offsets are within one cell of the grid, so a wrap or a
-                    // clamp is one comparison (no integer division).
-                    if *periodic {
-                        if ck < 0 {
-                            ck += n;
-                        } else if ck >= n {
-                            ck -= n;
-                        }
-                        if !(0..n).contains(&ck) {
-                            ck = ck.rem_euclid(n);
-                        }
-                    } else if ck < -1 || ck > n {
-                        return None;
-                    } else {
-                        // The edge cells extend to infinity: a point just outside
-                        // (rounding) or a neighbour offset past the edge lands there.
-                        ck = ck.clamp(0, n - 1);
-                    }
-                    index = index * counts[k] + ck;
-                }
-                Some(index as usize)
-            }
+            Cells::Direct { grid, .. } => grid.around(base, around),
             Cells::Hashed => {
-                // FNV-style mixing of the coordinates; clashes only cost extra candidates.
-                let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-                for &x in &c {
-                    h = (h ^ (x as u64)).wrapping_mul(0x0000_0100_0000_01b3);
-                    h ^= h >> 29;
+                let mut count = 0;
+                for offset in 0..3usize.pow(D as u32) {
+                    let c = self.hashed(Self::around(base, offset));
+                    if !around[..count].contains(&c) {
+                        around[count] = c;
+                        count += 1;
+                    }
                 }
-                Some((h as usize) & (self.members.count() - 1))
+                count
             }
         }
     }
 
+    /// The integer coordinates of the cell of `p`: in the grid for direct indexing (a
+    /// periodic axis wraps, a walled one extends its edge cells to infinity, so a point
+    /// just outside, by rounding, lands in the edge cell), unbounded when hashed.
+    /// Saturating casts keep far-away points finite.
+    fn cell_coords(&self, p: &Vector<T, D>) -> [i64; D] {
+        match &self.cells {
+            Cells::Direct { origin, grid } => core::array::from_fn(|k| {
+                let c = floor_to_i64((p[k] - origin[k]) * self.inv_cell[k]);
+                let n = grid.counts()[k];
+                if self.period.is_some() {
+                    c.rem_euclid(n)
+                } else {
+                    c.clamp(0, n - 1)
+                }
+            }),
+            Cells::Hashed => core::array::from_fn(|k| floor_to_i64(p[k] * self.inv_cell[k])),
+        }
+    }
+
+    /// The bucket of the (unbounded) cell `c` in the hashed table: FNV-style mixing of the
+    /// coordinates; clashes only cost extra candidates.
+    fn hashed(&self, c: [i64; D]) -> usize {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for &x in &c {
+            h = (h ^ (x as u64)).wrapping_mul(0x0000_0100_0000_01b3);
+            h ^= h >> 29;
+        }
+        (h as usize) & (self.members.count() - 1)
+    }
+
+    /// The row index of the cell of `p`.
     fn cell_index(&self, p: &Vector<T, D>) -> usize {
-        self.index_of(self.cell_coords(p))
-            .expect("a point's own cell always exists")
+        let c = self.cell_coords(p);
+        match &self.cells {
+            Cells::Direct { grid, .. } => grid.index(c),
+            Cells::Hashed => self.hashed(c),
+        }
     }
 }
 

@@ -5,12 +5,14 @@
 //! collision with each partner. Each search is given the best time found so far as its
 //! horizon, so later candidates stop early.
 
-use carom_geometry::Ball;
+use carom_geometry::{Ball, Period};
 use carom_math::{Real, Space, Vector};
-use carom_toi::{Kinematics, Window, ball_ball, ball_border, ball_obb, level_crossing};
+use carom_toi::{
+    Kinematics, Window, ball_ball, ball_ball_time, ball_border, ball_obb, level_crossing,
+};
 use nalgebra::Const;
 
-use super::state::Support;
+use super::state::{Mode, Support};
 use super::{EventEngine, Partners, Pending};
 
 /// A rebuild is scheduled when the ball has moved this fraction of the shell, keeping a
@@ -164,38 +166,79 @@ where
         best: &mut Best<T>,
         near: Near,
     ) {
-        let now = self.now;
-        let periodic = self.periodic_border();
-        let centre = ball.center();
-        let mut consider = |j: usize| {
-            if j == i || self.is_stuck(j) {
-                return;
-            }
-            let d = self.balls.position_at(j, now) - centre;
-            let d = match periodic {
-                Some(border) => border.minimum_image(&d),
-                None => d,
-            };
-            let other = Ball::new_unchecked(centre + d, self.balls.motion[j].radius);
-            let kin_j =
-                Kinematics::new_unchecked(self.balls.velocity_at(j, now), self.balls.accel(j));
-            if let Some(s) = ball_ball(ball, kin, &other, &kin_j, &best.window(now)).hit_time() {
-                best.offer(
-                    now + s,
-                    Pending::Ball {
-                        j: j as u32,
-                        count: self.balls.count[j],
-                    },
-                );
-            }
+        let probe = Probe {
+            i,
+            now: self.now,
+            ball,
+            kin,
+            period: self.period.as_ref(),
+            clusters: !self.clusters.is_empty(),
+            accelerated: self.balls.accelerated,
         };
         match (near, &self.partners) {
             (Near::Entering { axis, upper }, Partners::Cells(cells)) => {
-                cells.for_each_entering(i, axis, upper, &mut consider);
+                cells.for_each_entering(i, axis, upper, |j| self.offer_partner(&probe, j, best));
             }
-            _ => self
-                .partners
-                .for_each(i, self.balls.len(), true, &mut consider),
+            (_, Partners::Cells(cells)) => {
+                cells.for_each_near(i, |j| self.offer_partner(&probe, j, best));
+            }
+            (_, Partners::Lists(lists)) => {
+                for j in lists.partners(i) {
+                    self.offer_partner(&probe, j as usize, best);
+                }
+            }
+            (_, Partners::All { .. }) => {
+                for j in 0..self.balls.len() {
+                    self.offer_partner(&probe, j, best);
+                }
+            }
+        }
+    }
+
+    /// The first collision of the probed ball with ball `j`, if it comes before the best
+    /// event so far: the inner loop of the engine, inlined into each way of visiting
+    /// partners, with what it reads of the probed ball and the world read once
+    /// ([`Probe`]). Inlined always: with a plain `#[inline]` the compiler kept it a call in
+    /// the neighbour-list loop, 3 % more instructions per collision in the 3D gas
+    /// (callgrind, N = 4,000).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
+    fn offer_partner(&self, probe: &Probe<'_, T, D>, j: usize, best: &mut Best<T>) {
+        if j == probe.i || (probe.clusters && matches!(self.balls.mode[j], Mode::Stuck(_))) {
+            return;
+        }
+        let now = probe.now;
+        let centre = probe.ball.center();
+        let d = self.balls.position_at(j, now) - centre;
+        let d = match probe.period {
+            Some(period) => period.minimum_image(&d),
+            None => d,
+        };
+        let other = Ball::new_unchecked(centre + d, self.balls.motion[j].radius);
+        let velocity_j = self.balls.velocity_at(j, now);
+        let window = best.window(now);
+        // A common acceleration (none, or the same gravity) cancels: the pair's relative
+        // motion is linear, and only the time is needed.
+        let hit = if !probe.accelerated || self.balls.accel[j] == probe.kin.acceleration() {
+            ball_ball_time(
+                probe.ball,
+                &probe.kin.velocity(),
+                &other,
+                &velocity_j,
+                &window,
+            )
+        } else {
+            let kin_j = Kinematics::new_unchecked(velocity_j, self.balls.accel[j]);
+            ball_ball(probe.ball, probe.kin, &other, &kin_j, &window).hit_time()
+        };
+        if let Some(s) = hit {
+            best.offer(
+                now + s,
+                Pending::Ball {
+                    j: j as u32,
+                    count: self.balls.count[j],
+                },
+            );
         }
     }
 
@@ -235,6 +278,20 @@ enum Near {
     /// Those a ball's neighbourhood gained when it crossed the face (`axis`, `upper`)
     /// into its cell (cell lists).
     Entering { axis: usize, upper: bool },
+}
+
+/// What a prediction of ball `i` against its partners reads once, not once per partner.
+struct Probe<'a, T: Real, const D: usize> {
+    i: usize,
+    now: T,
+    ball: &'a Ball<T, D>,
+    kin: &'a Kinematics<T, D>,
+    /// The periods of a periodic border.
+    period: Option<&'a Period<T, D>>,
+    /// `true` while stuck clusters exist (a partner's mode is read only then).
+    clusters: bool,
+    /// `true` under gravity (accelerations are read only then).
+    accelerated: bool,
 }
 
 /// The earliest candidate event so far; later searches use its time as their horizon.

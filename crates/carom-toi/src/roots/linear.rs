@@ -34,7 +34,7 @@
 //! error of products that underflow (at most half the smallest subnormal each), so the
 //! filter stays rigorous for tiny inputs, which simply fall back.
 //!
-//! * **Quick test** ([`recedes_or_misses`], in the input precision, from the centres,
+//! * **Quick test** ([`certainly_clear`], in the input precision, from the centres,
 //!   velocities and radii). The differences `û = fl(c₂ − c₁)`, `ŵ = fl(v₂ − v₁)`,
 //!   `R̂ = fl(r₁ + r₂)` are within `u` (relative, per component) of the exact ones.
 //!   *Rate*: `|h − fl(û·ŵ)| <= (2u + u² + γ_D (1 + 2u)) A`, `A = Σ|ûᵢŵᵢ|`, bounded by
@@ -43,7 +43,13 @@
 //!   the differences (using `A² <= s a`) and its plain evaluation errs by at most
 //!   `u a (17.9 s + 7.3 q)` (the terms of `E_Δ` below, each bounded through `A² <= s a`
 //!   and `|c| <= s + q`); `Δ̂ < −32 u â (ŝ + q̂)` proves `Δ < 0`, a miss (`Δ < 0` also
-//!   implies `c > 0`: apart, and never touching).
+//!   implies `c > 0`: apart, and never touching). *Horizon*: `P(t) >= c + 2 h t`, so
+//!   `c + 2 h H > 0` (with `h < 0`, which makes `c > 0` too) proves no contact on
+//!   `[0, H]`. The rounded differences move `s` by at most `(D + 3) u ŝ` (as `h`), `q̂` is
+//!   within `4u q̂`, and the sums and products add `u` of each term, so the computed
+//!   `ĉ + 2 ĥ H` is within `(D + 5) u (ŝ + q̂ + 2 H Â)` of exact to first order;
+//!   `ĉ + 2ĥH > 32 u (ŝ + q̂ + 2 H Â)` proves it. A pair predicted against the best time
+//!   found so far leaves here without a square root when it would meet later.
 //! * **Rate** (`f64`, on the exact differences). `|ĥ − h| <= γ_D Σ|uᵢ wᵢ|`, bounded by
 //!   `E_h = (D + 1) u fl(Σ|uᵢwᵢ|)`; `|ĥ| <= E_h` falls back.
 //! * **Gap.** `ŝ = fl(Σ uᵢ²)`, `q̂ = fl(r²)`, `ĉ = fl(ŝ − q̂)`:
@@ -95,15 +101,17 @@ pub(crate) enum LinearContact<T> {
 }
 
 /// `true` if two balls (centres `c₁`, `c₂`, velocities `v₁`, `v₂`, radii `r₁`, `r₂`,
-/// time running in the direction of `sign = ±1`) certainly recede or certainly miss:
-/// the cheap test callers make inline, in the input precision, before anything else
-/// (module docs, "Quick test").
+/// time running in the direction of `sign = ±1`) certainly recede, certainly miss, or
+/// certainly meet only after `horizon` (search time, `+∞` for none): the cheap test
+/// callers make inline, in the input precision, before anything else (module docs,
+/// "Quick test").
 #[inline]
-pub(crate) fn recedes_or_misses<T: Real, const D: usize>(
+pub(crate) fn certainly_clear<T: Real, const D: usize>(
     (c1, c2): (&Vector<T, D>, &Vector<T, D>),
     (v1, v2): (&Vector<T, D>, &Vector<T, D>),
     (r1, r2): (T, T),
     sign: T,
+    horizon: T,
 ) -> bool {
     let unit = unit::<T>();
     let (u0, w0) = (c2[0] - c1[0], v2[0] - v1[0]);
@@ -126,8 +134,17 @@ pub(crate) fn recedes_or_misses<T: Real, const D: usize>(
     }
     let r = r1 + r2;
     let q = r * r;
-    let disc = h * h - a * (s - q);
-    disc < -(a * (s + q) * (T::lit(32.0) * unit) + T::MIN_POSITIVE)
+    let c = s - q;
+    let disc = h * h - a * c;
+    if disc < -(a * (s + q) * (T::lit(32.0) * unit) + T::MIN_POSITIVE) {
+        return true;
+    }
+    // Beyond the horizon `H`: `P(t) = c + 2 h t + a t² >= c + 2 h t`, a line, positive
+    // on all of `[0, H]` when positive at `0` and at `H`, and `c + 2hH > 0` with `h < 0`
+    // implies `c > 0`. (An infinite `H` gives −∞ or NaN here: never true.)
+    let reach = horizon * (h + h);
+    c + reach
+        > (s + q + horizon * (magnitude + magnitude)) * (T::lit(32.0) * unit) + T::MIN_POSITIVE
 }
 
 /// The unit roundoff `u = ε/2`.
@@ -238,10 +255,10 @@ impl<T: Real, const D: usize> LinearSphere<T, D> {
     }
 
     /// The first contact from time 0 up to `hi` (`+∞` allowed), cheapest case first
-    /// (module docs). `budget` is the relative error allowed for a root computed without
-    /// the double-double discriminant.
+    /// (module docs). `budget` is the error allowed for a root computed without the
+    /// double-double discriminant.
     #[inline]
-    pub(crate) fn first_contact(&self, hi: T, budget: T) -> LinearContact<T> {
+    pub(crate) fn first_contact(&self, hi: T, budget: Budget<T>) -> LinearContact<T> {
         let p = self.plain();
         let (h, c, disc) = (p.h, p.c, p.disc);
         if h.value > h.err {
@@ -260,7 +277,7 @@ impl<T: Real, const D: usize> LinearSphere<T, D> {
             }
             if c.value > p.touch + c.err && disc.value > disc.err {
                 // A certain hit: the plain root if the bound proves it ...
-                match accurate_root(h, c, disc, budget) {
+                match accurate_root(h, c, disc, p.a, budget) {
                     Ok(t) => return contact_before(t, hi),
                     // ... or the root certainly beyond the horizon ...
                     Err(t_min) if hi.finite() && t_min() > hi => return LinearContact::Clear,
@@ -275,7 +292,12 @@ impl<T: Real, const D: usize> LinearSphere<T, D> {
     /// [`first_contact`](Self::first_contact) with `h` and `c` in double-double, and then
     /// `Δ` if needed; out of line.
     #[inline(never)]
-    fn sharpened_contact(&self, plain: &Coefficients<T>, hi: T, budget: T) -> LinearContact<T> {
+    fn sharpened_contact(
+        &self,
+        plain: &Coefficients<T>,
+        hi: T,
+        budget: Budget<T>,
+    ) -> LinearContact<T> {
         let (dd_h, dd_c, sharp) = self.sharpen(plain);
         if sharp.h.value >= T::zero() {
             return LinearContact::Clear;
@@ -288,7 +310,7 @@ impl<T: Real, const D: usize> LinearSphere<T, D> {
             return LinearContact::Clear;
         }
         if disc.value > disc.err
-            && let Ok(t) = accurate_root(sharp.h, sharp.c, disc, budget)
+            && let Ok(t) = accurate_root(sharp.h, sharp.c, disc, sharp.a, budget)
         {
             return contact_before(t, hi);
         }
@@ -395,22 +417,43 @@ fn bounded_discriminant<T: Real, const D: usize>(h: Bounded<T>, a: T, c: Bounded
     Bounded { value: disc, err }
 }
 
+/// The error a root may have when it is computed without the double-double
+/// discriminant: a relative error (besides the final `3u`), or a distance.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Budget<T> {
+    /// The relative error allowed.
+    pub(crate) relative: T,
+    /// A distance: the root is also accepted when its error moves the relative position
+    /// `u + w t` by at most this much (`0`: the relative error alone decides).
+    pub(crate) reach: T,
+}
+
 /// The root `c / (−h + √Δ)` of a certain hit (`h < 0`, `c > 0`, `Δ > 0` proven) if the
-/// bounds prove it within `budget` (plus `3u`) of exact (module docs); otherwise a lower
+/// bounds prove it within the budget (plus `3u`) of exact (module docs); otherwise a lower
 /// bound on it, computed on demand.
+///
+/// The relative error of the root is at most `ρ = bound / scale` (plus `3u`). Within the
+/// budget's reach means `ρ t |w| <= reach`: squared, without a square root,
+/// `(bound · t)² · a <= (reach · scale)²` (`a = |w|²`; all terms are non-negative, and an
+/// overflow to `∞` only refuses).
 #[inline]
 fn accurate_root<T: Real>(
     h: Bounded<T>,
     c: Bounded<T>,
     disc: Bounded<T>,
-    budget: T,
+    a: T,
+    budget: Budget<T>,
 ) -> Result<T, impl Fn() -> T> {
     let sigma = disc.value.sqrt();
     let d = sigma - h.value;
     let scale = c.value * d * sigma;
     let bound = c.err * d * sigma + c.value * (h.err * sigma + disc.err);
     let t = c.value / d;
-    if bound <= budget * scale {
+    let moved = bound * t;
+    let reach = budget.reach * scale;
+    if bound <= budget.relative * scale
+        || (budget.reach > T::zero() && moved * moved * a <= reach * reach)
+    {
         Ok(t)
     } else {
         // t >= t̂ (1 − ρ) with ρ = bound / scale + 3u; twice that covers second order.
@@ -500,7 +543,11 @@ mod tests {
     /// plus the reference's own `4u`.
     fn agrees(u: [i64; 3], w: [i64; 3], r: i64, budget: f64) -> Result<(), TestCaseError> {
         let e = exact(u, w, r);
-        let got = sphere(u, w, r).first_contact(f64::INFINITY, budget);
+        let exact_only = Budget {
+            relative: budget,
+            reach: 0.0,
+        };
+        let got = sphere(u, w, r).first_contact(f64::INFINITY, exact_only);
         match (got, reference(&e, r)) {
             (LinearContact::At(t), LinearContact::At(t_ref)) => {
                 prop_assert!(
@@ -563,18 +610,82 @@ mod tests {
             let (r1f, r2f) = (r1 as f32 as i64, r2 as f32 as i64);
             let e = exact(d(c1f, c2f), d(v1f, v2f).map(|x| x * sign), r1f + r2f);
             let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
-            if recedes_or_misses(
+            if certainly_clear(
                 (&v3(c1f), &v3(c2f)),
                 (&v3(v1f), &v3(v2f)),
                 (r1f as f32, r2f as f32),
                 sign as f32,
+                f32::INFINITY,
             ) {
                 prop_assert!(e.h > 0 || e.disc < 0, "{e:?}");
             }
             let e = exact(d(c1, c2), d(v1, v2).map(|x| x * sign), r1 + r2);
             let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
-            if recedes_or_misses((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1 as f64, r2 as f64), sign as f64) {
+            if certainly_clear((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1 as f64, r2 as f64), sign as f64, f64::INFINITY) {
                 prop_assert!(e.h > 0 || e.disc < 0, "{e:?}");
+            }
+        }
+
+        /// The horizon part of the quick test never drops a contact at or before the
+        /// horizon: closing pairs placed at random offsets (so that the differences of
+        /// the inputs round in f32), with the horizon within `2^-k` of the first contact,
+        /// before or after it. The reference decides exactly, in integers: no contact on
+        /// `[0, H]` iff `P(H) > 0` and `H` comes before the vertex `−h/a`.
+        #[test]
+        fn quick_test_never_drops_a_contact_before_the_horizon(
+            u in prop::array::uniform3(-(1i64 << 20)..(1 << 20)),
+            w in prop::array::uniform3(-(1i64 << 20)..(1 << 20)),
+            r in 1i64..(1 << 20), k in 1i32..52, later in any::<bool>(),
+            offset in int3(), drift in int3(), near in any::<bool>(), gap in 1i64..64,
+        ) {
+            const SCALE: i128 = 1 << 20;
+            // `near`: almost touching and closing head-on, where the contact is where the
+            // line `c + 2ht` crosses zero (`a t²` below the rounding of `c`).
+            let (u, w) = if near {
+                let r = r.max(1 << 10);
+                ([r + gap, u[1] >> 12, u[2] >> 12], [-(w[0].abs() >> 4) - 1, w[1] >> 14, w[2] >> 14])
+            } else {
+                closing(u, w)
+            };
+            let r = if near { r.max(1 << 10) } else { r };
+            let add = |x: [i64; 3], y: [i64; 3]| [0, 1, 2].map(|i| x[i] + y[i]);
+            let d = |x: [i64; 3], y: [i64; 3]| [0, 1, 2].map(|i| y[i] - x[i]);
+            let (c1, c2, v1, v2) = (offset, add(offset, u), drift, add(drift, w));
+            let f = |x: [i64; 3]| x.map(|v| v as f32 as i64);
+            let (r1, r2) = (r / 2 + 1, r - r / 2);
+            let cases = [
+                (d(f(c1), f(c2)), d(f(v1), f(v2)), (r1 as f32 as i64, r2 as f32 as i64), true),
+                (u, w, (r1, r2), false),
+            ];
+            for (u, w, (r1, r2), single) in cases {
+                let e = exact(u, w, r1 + r2);
+                if e.a == 0 || e.h >= 0 || e.c <= 0 || e.disc <= 0 {
+                    continue;
+                }
+                let t1 = e.c as f64 / (-(e.h as f64) + (e.disc as f64).sqrt());
+                if t1 > 1e6 {
+                    continue;
+                }
+                let moved = t1 * (1.0 + if later { 1.0 } else { -1.0 } * 2f64.powi(-k));
+                // The horizon as a multiple of 2^-20, exact in f32 and f64 here.
+                let n = (moved * SCALE as f64).round().max(0.0) as i128;
+                let horizon = n as f64 / SCALE as f64;
+                let p_at_horizon = e.c * SCALE * SCALE + 2 * e.h * n * SCALE + e.a * n * n;
+                let clear = p_at_horizon > 0 && e.a * n + e.h * SCALE < 0;
+                let claimed = if single {
+                    let v = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
+                    certainly_clear(
+                        (&v(f(c1)), &v(f(c2))),
+                        (&v(f(v1)), &v(f(v2))),
+                        (r1 as f32, r2 as f32),
+                        1.0,
+                        horizon as f32,
+                    )
+                } else {
+                    let v = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
+                    certainly_clear((&v(c1), &v(c2)), (&v(v1), &v(v2)), (r1 as f64, r2 as f64), 1.0, horizon)
+                };
+                prop_assert!(!claimed || clear, "f32 {single}: {e:?} H = {horizon} t1 = {t1}");
             }
         }
 
@@ -608,18 +719,19 @@ mod tests {
                 let (r1, r2) = ((r / 2) as f32 as i64, (r - r / 2) as f32 as i64);
                 let e = exact(d(f(c1), f(c2)), d(f(v1), f(v2)).map(|x| x * sign), r1 + r2);
                 let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
-                if recedes_or_misses(
+                if certainly_clear(
                     (&v3(c1), &v3(c2)),
                     (&v3(v1), &v3(v2)),
                     (r1 as f32, r2 as f32),
                     sign as f32,
+                    f32::INFINITY,
                 ) {
                     prop_assert!(e.h > 0 || e.disc < 0, "f32 {e:?}");
                 }
                 let e = exact(u, w.map(|x| x * sign), r);
                 let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
                 let (r1, r2) = ((r / 2) as f64, (r - r / 2) as f64);
-                if recedes_or_misses((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1, r2), sign as f64) {
+                if certainly_clear((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1, r2), sign as f64, f64::INFINITY) {
                     prop_assert!(e.h > 0 || e.disc < 0, "f64 {e:?}");
                 }
             }

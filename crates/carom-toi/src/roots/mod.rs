@@ -16,7 +16,7 @@ mod sphere;
 
 pub(crate) use descent::{Descent, first_descent_monotone};
 pub(crate) use itp::itp;
-pub(crate) use linear::{LinearContact, LinearSphere, recedes_or_misses};
+pub(crate) use linear::{Budget, LinearContact, LinearSphere, certainly_clear};
 pub(crate) use quadratic::Quadratic;
 pub(crate) use sphere::SphereGap;
 
