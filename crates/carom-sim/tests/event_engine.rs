@@ -144,8 +144,8 @@ fn a_slow_closing_across_a_tiny_gap_is_one_exact_collision_not_a_false_one() {
     // PhET's linear fallback fires false collisions for slow closings; here the exact
     // root gives the time of a 1e-12 gap closed at 1e-6 m/s, exact to the resolution of
     // the coordinates: the balls meet within four roundings of the larger coordinate
-    // (|x| <= 0.2) of touching (carom-toi's `ball_ball_time`), though at this speed that
-    // is a few parts per million of the time.
+    // (|x| <= 0.2) of touching (carom-toi's `relative_contact_time` with the engine's
+    // reach), though at this speed that is a few parts per million of the time.
     let mut scene = classic::head_on(1.0, 1.0, 1e-6, 0.0, 1.0);
     scene.balls[0].pos = Vector2::new(-0.2 - 1e-12, 0.0);
     scene.balls[1].pos = Vector2::new(0.0, 0.0);

@@ -72,9 +72,9 @@ pub fn ball_ball<T: Real, const D: usize>(
     // most of all, leave after a few dot products in the input precision, without a
     // square root; the rest continues in f64, out of line.
     if certainly_clear(
-        (&ball1.center(), &ball2.center()),
-        (&motion1.velocity(), &motion2.velocity()),
-        (ball1.radius(), ball2.radius()),
+        &(ball2.center() - ball1.center()),
+        &(motion2.velocity() - motion1.velocity()),
+        ball1.radius() + ball2.radius(),
         window.direction().sign(),
         window.horizon(),
     ) {
@@ -84,74 +84,91 @@ pub fn ball_ball<T: Real, const D: usize>(
 }
 
 /// The first contact time of two balls in linear relative motion (constant velocities,
-/// or a common acceleration, which cancels), looking in the window's direction: the time
-/// [`ball_ball`] returns as [`Toi::hit_time`] for such a pair, to the resolution of the
-/// coordinates, without the normal and the contact point.
+/// or a common acceleration, which cancels), given as the relative position
+/// `offset = c₂ − c₁` now, the relative velocity `velocity = v₂ − v₁` and the sum of the
+/// radii `radius = r₁ + r₂`, looking in the window's direction: the time [`ball_ball`]
+/// returns as [`Toi::hit_time`] for such a pair, to a resolution of positions the caller
+/// gives, without the normal and the contact point.
 ///
 /// For an engine that schedules events and computes each contact only when it comes
 /// due: it predicts many pairs per event and keeps at most one, so the normal and point
-/// (a square root, a division and a dozen products per hit) are wasted on the rest. The
-/// same filtered arithmetic decides every pair (receding and missing pairs leave after
-/// the same few dot products, pairs that meet only after the horizon as well), with one
-/// difference: [`ball_ball`] proves every root within `16u` of exact (`u` the unit
-/// roundoff), recomputing in double-double when the plain bound cannot, while here a
-/// plain root is also accepted when its proven error moves the balls' relative position
-/// by at most `4 u_T · max_k(|c₁ₖ|, |c₂ₖ|)` (`u_T` the unit roundoff of `T`), four
-/// roundings of the largest coordinate of the centres, whose own rounding the contact
-/// cannot resolve better. Near touching the plain bound fails the relative budget for
-/// almost every pair (`c = |u|² − R²` cancels), and in a dense gas that recomputation was
-/// a fifth of the time of impact's cost (docs/toi.md). Touching, closing pairs are
-/// `Some(0)`, as with [`ball_ball`]. `None` for a pair that recedes, misses, meets beyond
-/// the horizon or, as for [`Status::NotConverged`], overflows.
+/// (a square root, a division and a dozen products per hit) are wasted on the rest, and
+/// it has the relative motion at hand. The same filtered arithmetic decides every pair
+/// (receding and missing pairs leave after a few dot products, pairs that meet only after
+/// the horizon as well), with one difference: [`ball_ball`] proves every root within
+/// `16u` of exact (`u` the unit roundoff), recomputing in double-double when the plain
+/// bound cannot, while here a plain root is also accepted when its proven error moves the
+/// relative position by at most `reach`. An engine passes the resolution of its
+/// coordinates (the event-driven engine: `4 u_T` times the largest coordinate, four
+/// roundings of it; `0` asks for `ball_ball`'s accuracy). Near touching the plain bound
+/// fails the relative budget for almost every pair (`c = |u|² − R²` cancels), and in a
+/// dense gas that recomputation was a twelfth of the engine's work (docs/toi.md).
+/// Touching, closing pairs are `Some(0)`, as with [`ball_ball`]. `None` for a pair that
+/// recedes, misses, meets beyond the horizon or, as for [`Status::NotConverged`],
+/// overflows.
 ///
 /// ```
-/// use carom_toi::{ball_ball_time, Window};
-/// use carom_geometry::Ball;
+/// use carom_toi::{relative_contact_time, Window};
 /// use nalgebra::Vector2;
 ///
-/// let a = Ball::new(Vector2::new(0.0, 0.0), 0.5)?;
-/// let b = Ball::new(Vector2::new(3.0, 0.0), 0.5)?;
-/// let (toward, still) = (Vector2::new(1.0, 0.0), Vector2::zeros());
-/// assert_eq!(ball_ball_time(&a, &toward, &b, &still, &Window::forward(10.0)?), Some(2.0));
-/// assert_eq!(ball_ball_time(&a, &toward, &b, &still, &Window::forward(1.0)?), None);
+/// // Ball 2 three units ahead, ball 1 closing at 1 unit per second; radii sum to 1.
+/// let (offset, velocity) = (Vector2::new(3.0, 0.0), Vector2::new(-1.0, 0.0));
+/// let within = |horizon| Window::forward(horizon);
+/// assert_eq!(relative_contact_time(&offset, &velocity, 1.0, &within(10.0)?, 0.0), Some(2.0));
+/// assert_eq!(relative_contact_time(&offset, &velocity, 1.0, &within(1.0)?, 0.0), None);
 /// # Ok::<(), carom_math::InvalidValue>(())
 /// ```
 #[inline]
-pub fn ball_ball_time<T: Real, const D: usize>(
-    ball1: &Ball<T, D>,
-    velocity1: &Vector<T, D>,
-    ball2: &Ball<T, D>,
-    velocity2: &Vector<T, D>,
+pub fn relative_contact_time<T: Real, const D: usize>(
+    offset: &Vector<T, D>,
+    velocity: &Vector<T, D>,
+    radius: T,
     window: &Window<T>,
+    reach: T,
 ) -> Option<T> {
     if certainly_clear(
-        (&ball1.center(), &ball2.center()),
-        (velocity1, velocity2),
-        (ball1.radius(), ball2.radius()),
+        offset,
+        velocity,
+        radius,
         window.direction().sign(),
         window.horizon(),
     ) {
         return None;
     }
-    linear_time(ball1, velocity1, ball2, velocity2, window)
+    relative_time(offset, velocity, radius, window, reach)
 }
 
-/// [`ball_ball_time`] for a pair not proven to recede or miss, out of line.
+/// [`relative_contact_time`] for a pair not proven to recede or miss, out of line, in
+/// `f64` whatever `T` is.
 #[inline(never)]
-fn linear_time<T: Real, const D: usize>(
-    ball1: &Ball<T, D>,
-    velocity1: &Vector<T, D>,
-    ball2: &Ball<T, D>,
-    velocity2: &Vector<T, D>,
+fn relative_time<T: Real, const D: usize>(
+    offset: &Vector<T, D>,
+    velocity: &Vector<T, D>,
+    radius: T,
     window: &Window<T>,
+    reach: T,
 ) -> Option<T> {
-    let coordinate = ball1.center().amax().max(ball2.center().amax()).to_f64();
-    let reach = 2.0 * T::EPSILON.to_f64() * coordinate;
-    match linear_gap(ball1, velocity1, ball2, velocity2, window, reach).0 {
+    let wide = |v: &Vector<T, D>| v.map(T::to_f64);
+    let gap = LinearSphere::new(
+        wide(offset),
+        window.direction().orient(&wide(velocity)),
+        radius.to_f64(),
+    );
+    let budget = Budget {
+        relative: root_budget::<T>(),
+        reach: reach.to_f64(),
+    };
+    match gap.first_contact(window.horizon().to_f64(), budget) {
         LinearContact::At(s) => Some(window.signed(T::lit(s))),
         LinearContact::Immediate => Some(window.signed(T::zero())),
         LinearContact::Clear | LinearContact::Overflow => None,
     }
+}
+
+/// The relative error allowed for a plain root: 12 u in f64; for f32 output a sixteenth
+/// of its unit roundoff, so that the final rounding to f32 is the only visible error.
+fn root_budget<T: Real>() -> f64 {
+    (6.0 * f64::EPSILON).max(T::EPSILON.to_f64() / 32.0)
 }
 
 /// A linear pair not proven to recede or miss, computed in `f64` whatever `T` is: for
@@ -171,7 +188,6 @@ fn linear_ball_ball<T: Real, const D: usize>(
         ball2,
         &motion2.velocity(),
         window,
-        0.0,
     ) {
         (LinearContact::Clear, _) => Toi::no_hit(window.direction().sign(), ()),
         (LinearContact::At(s), gap) => linear_contact(Status::Hit, s, &gap, ball1, motion1, window),
@@ -182,9 +198,7 @@ fn linear_ball_ball<T: Real, const D: usize>(
     }
 }
 
-/// The first contact of a linear pair in search time, and its gap, in `f64`; a root is
-/// accepted without the double-double discriminant within `12u` relative, or when its
-/// error moves the relative position by at most `reach`.
+/// The first contact of a linear pair in search time, and its gap, in `f64`.
 #[inline]
 fn linear_gap<T: Real, const D: usize>(
     ball1: &Ball<T, D>,
@@ -192,7 +206,6 @@ fn linear_gap<T: Real, const D: usize>(
     ball2: &Ball<T, D>,
     velocity2: &Vector<T, D>,
     window: &Window<T>,
-    reach: f64,
 ) -> (LinearContact<f64>, LinearSphere<f64, D>) {
     // Computed in f64 whatever `T` is: for f32 input every difference and product is
     // then exact, for f64 it is the working precision.
@@ -204,11 +217,9 @@ fn linear_gap<T: Real, const D: usize>(
             .orient(&(wide(*velocity2) - wide(*velocity1))),
         ball1.radius().to_f64() + ball2.radius().to_f64(),
     );
-    // The root's error budget: 12 u in f64; for f32 output a sixteenth of its unit
-    // roundoff, so that the final rounding to f32 is the only visible error.
     let budget = Budget {
-        relative: (6.0 * f64::EPSILON).max(T::EPSILON.to_f64() / 32.0),
-        reach,
+        relative: root_budget::<T>(),
+        reach: 0.0,
     };
     (gap.first_contact(window.horizon().to_f64(), budget), gap)
 }

@@ -9,7 +9,7 @@
 //! | query | bodies | method |
 //! |---|---|---|
 //! | [`ball_ball`] | two balls, linear, same or differing constant accelerations | filtered cancellation-free quadratic root (plain arithmetic with proven bounds, double-double fallback); quartic with bracketed roots |
-//! | [`ball_ball_time`] | two balls in linear relative motion: the time alone, for event calendars | as `ball_ball`, without the normal and point |
+//! | [`relative_contact_time`] | two balls in linear relative motion: the time alone, for event calendars | as `ball_ball`, to a resolution of positions the caller gives |
 //! | [`ball_plane`] | ball and a static half-space, linear or under gravity | quadratic |
 //! | [`ball_border`] | ball inside a reflecting [`Border`](carom_geometry::Border): the first wall | quadratic per wall |
 //! | [`plane_crossing`], [`level_crossing`] | a centre crossing a plane or a level (periodic cell faces) | quadratic |
@@ -33,7 +33,7 @@ mod plane;
 mod roots;
 mod window;
 
-pub use ball::{ball_ball, ball_ball_time};
+pub use ball::{ball_ball, relative_contact_time};
 pub use border::ball_border;
 pub use carom_math::{InvalidValue, Real, Vector};
 pub use cluster::{

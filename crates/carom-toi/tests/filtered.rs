@@ -1,18 +1,19 @@
-//! `ball_ball` and `ball_ball_time` at the boundaries of their filtered arithmetic,
-//! against exact integer arithmetic: grazes far away, nearly touching pairs and
-//! tangential motions whose discriminant, gap or rate is within the plain error bound of
-//! zero, so that the double-double fallback decides them; through the public API, in f64
-//! and f32, forward and backward, at coordinates far from the origin. `ball_ball_time`
-//! must take every decision `ball_ball` takes, and its time may differ from exact by
-//! `ball_ball`'s tolerance or by a move of the relative position within four roundings of
-//! the largest coordinate, whichever is larger.
+//! `ball_ball` and `relative_contact_time` at the boundaries of their filtered
+//! arithmetic, against exact integer arithmetic: grazes far away, nearly touching pairs
+//! and tangential motions whose discriminant, gap or rate is within the plain error bound
+//! of zero, so that the double-double fallback decides them; through the public API, in
+//! f64 and f32, forward and backward, at coordinates far from the origin.
+//! `relative_contact_time` must take every decision `ball_ball` takes; with a reach of
+//! zero its time is as accurate as `ball_ball`'s, and with the event engine's reach (four
+//! roundings of the largest coordinate) it may also differ by a move of the relative
+//! position within that reach.
 //!
 //! Inputs are integers (below `2^29` in f64, `2^24` in f32), so every coefficient of
 //! `|u + w t|² − R²` is an exact `i128`; the reference root is computed in f64 from the
 //! exact integers (within about `4u`).
 
 use carom_geometry::Ball;
-use carom_toi::{Direction, Kinematics, Real, Status, Window, ball_ball, ball_ball_time};
+use carom_toi::{Direction, Kinematics, Real, Status, Window, ball_ball, relative_contact_time};
 use nalgebra::Vector3;
 use proptest::prelude::*;
 
@@ -62,7 +63,7 @@ fn reference(e: &Exact, r: i64) -> (Status, f64) {
 /// Runs `ball_ball` for ball 1 at `offset` at rest and ball 2 at `offset + u` moving at
 /// `w` (backward: at `−w`, so the forward answer applies), radii splitting `R`, and
 /// checks it against the exact reference: status, time within `tolerance · t`, and a unit
-/// normal along the offset at contact; and `ball_ball_time` on the same pair (see the
+/// normal along the offset at contact; and `relative_contact_time` on the same pair (see the
 /// module docs).
 fn check<T: Real>(
     u: [i64; 3],
@@ -110,18 +111,26 @@ fn check<T: Real>(
         Status::AlreadyTouching => prop_assert_eq!(toi.time, T::zero()),
         _ => prop_assert!(toi.time.to_f64().is_infinite()),
     }
-    let time = ball_ball_time(&b1, &Vector3::zeros(), &b2, &v(velocity), &window);
-    prop_assert_eq!(time.is_some(), toi.is_hit(), "{:?}", e);
-    if let Some(time) = time {
-        let t = time.to_f64() * sign;
-        let speed = (e.a as f64).sqrt();
-        let coordinate = b1.center().amax().max(b2.center().amax()).to_f64();
-        let reach = 2.0 * T::EPSILON.to_f64() * coordinate;
-        prop_assert!(
-            (t - t_ref).abs() * speed <= reach + tolerance * t_ref * speed,
-            "{t} vs {t_ref}, moving {} against a reach of {reach}: {e:?}",
-            (t - t_ref).abs() * speed
+    let offset = b2.center() - b1.center();
+    let coordinate = b1.center().amax().max(b2.center().amax()).to_f64();
+    let speed = (e.a as f64).sqrt();
+    for reach in [0.0, 2.0 * T::EPSILON.to_f64() * coordinate] {
+        let time = relative_contact_time(
+            &offset,
+            &v(velocity),
+            b1.radius() + b2.radius(),
+            &window,
+            T::lit(reach),
         );
+        prop_assert_eq!(time.is_some(), toi.is_hit(), "{:?}", e);
+        if let Some(time) = time {
+            let t = time.to_f64() * sign;
+            prop_assert!(
+                (t - t_ref).abs() * speed <= reach + tolerance * t_ref * speed,
+                "{t} vs {t_ref}, moving {} against a reach of {reach}: {e:?}",
+                (t - t_ref).abs() * speed
+            );
+        }
     }
     Ok(())
 }

@@ -8,7 +8,7 @@
 use carom_geometry::{Ball, Period};
 use carom_math::{Real, Space, Vector};
 use carom_toi::{
-    Kinematics, Window, ball_ball, ball_ball_time, ball_border, ball_obb, level_crossing,
+    Kinematics, Window, ball_ball, ball_border, ball_obb, level_crossing, relative_contact_time,
 };
 use nalgebra::Const;
 
@@ -174,6 +174,7 @@ where
             period: self.period.as_ref(),
             clusters: !self.clusters.is_empty(),
             accelerated: self.balls.accelerated,
+            reach: T::lit(2.0) * T::EPSILON * ball.center().amax(),
         };
         match (near, &self.partners) {
             (Near::Entering { axis, upper }, Partners::Cells(cells)) => {
@@ -208,26 +209,26 @@ where
             return;
         }
         let now = probe.now;
-        let centre = probe.ball.center();
-        let d = self.balls.position_at(j, now) - centre;
-        let d = match probe.period {
-            Some(period) => period.minimum_image(&d),
-            None => d,
+        let radius = self.balls.motion[j].radius;
+        let offset = self.balls.position_at(j, now) - probe.ball.center();
+        let offset = match probe.period {
+            Some(period) => period.minimum_image(&offset),
+            None => offset,
         };
-        let other = Ball::new_unchecked(centre + d, self.balls.motion[j].radius);
         let velocity_j = self.balls.velocity_at(j, now);
         let window = best.window(now);
         // A common acceleration (none, or the same gravity) cancels: the pair's relative
         // motion is linear, and only the time is needed.
         let hit = if !probe.accelerated || self.balls.accel[j] == probe.kin.acceleration() {
-            ball_ball_time(
-                probe.ball,
-                &probe.kin.velocity(),
-                &other,
-                &velocity_j,
+            relative_contact_time(
+                &offset,
+                &(velocity_j - probe.kin.velocity()),
+                probe.ball.radius() + radius,
                 &window,
+                probe.reach,
             )
         } else {
+            let other = Ball::new_unchecked(probe.ball.center() + offset, radius);
             let kin_j = Kinematics::new_unchecked(velocity_j, self.balls.accel[j]);
             ball_ball(probe.ball, probe.kin, &other, &kin_j, &window).hit_time()
         };
@@ -292,6 +293,11 @@ struct Probe<'a, T: Real, const D: usize> {
     clusters: bool,
     /// `true` under gravity (accelerations are read only then).
     accelerated: bool,
+    /// The resolution of positions here, four roundings of the ball's largest coordinate
+    /// (its partners' are about the same): a contact time is accepted without its
+    /// double-double check when its error moves the pair by less (carom-toi's
+    /// `relative_contact_time`).
+    reach: T,
 }
 
 /// The earliest candidate event so far; later searches use its time as their horizon.

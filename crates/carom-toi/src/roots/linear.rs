@@ -100,39 +100,34 @@ pub(crate) enum LinearContact<T> {
     Overflow,
 }
 
-/// `true` if two balls (centres `c₁`, `c₂`, velocities `v₁`, `v₂`, radii `r₁`, `r₂`,
-/// time running in the direction of `sign = ±1`) certainly recede, certainly miss, or
-/// certainly meet only after `horizon` (search time, `+∞` for none): the cheap test
-/// callers make inline, in the input precision, before anything else (module docs,
-/// "Quick test").
+/// `true` if two balls whose relative position is `u`, relative velocity `w` and radius
+/// sum `r` (each possibly rounded: `û = fl(c₂ − c₁)`, and so on), with time running in the
+/// direction of `sign = ±1`, certainly recede, certainly miss, or certainly meet only
+/// after `horizon` (search time, `+∞` for none): the cheap test callers make inline, in
+/// the input precision, before anything else (module docs, "Quick test").
 #[inline]
 pub(crate) fn certainly_clear<T: Real, const D: usize>(
-    (c1, c2): (&Vector<T, D>, &Vector<T, D>),
-    (v1, v2): (&Vector<T, D>, &Vector<T, D>),
-    (r1, r2): (T, T),
+    u: &Vector<T, D>,
+    w: &Vector<T, D>,
+    r: T,
     sign: T,
     horizon: T,
 ) -> bool {
     let unit = unit::<T>();
-    let (u0, w0) = (c2[0] - c1[0], v2[0] - v1[0]);
-    let mut h = u0 * w0;
+    // The rate first: this branch goes either way about half of the time, and it
+    // resolves as soon as `h` is known; its proof, almost always true, comes second.
+    let mut h = u[0] * w[0];
     let mut magnitude = h.abs();
-    let (mut a, mut s) = (w0 * w0, u0 * u0);
     for i in 1..D {
-        let (u, w) = (c2[i] - c1[i], v2[i] - v1[i]);
-        let p = u * w;
+        let p = u[i] * w[i];
         h += p;
         magnitude += p.abs();
-        a += w * w;
-        s += u * u;
     }
-    // The plain sign first: this branch goes either way about half of the time, and it
-    // resolves as soon as `h` is known; its proof, almost always true, comes second.
     let h = h * sign;
     if h > T::zero() && h > magnitude * (T::from_count(D + 3) * unit) + T::MIN_POSITIVE {
         return true;
     }
-    let r = r1 + r2;
+    let (a, s) = (w.norm_squared(), u.norm_squared());
     let q = r * r;
     let c = s - q;
     let disc = h * h - a * c;
@@ -610,18 +605,12 @@ mod tests {
             let (r1f, r2f) = (r1 as f32 as i64, r2 as f32 as i64);
             let e = exact(d(c1f, c2f), d(v1f, v2f).map(|x| x * sign), r1f + r2f);
             let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
-            if certainly_clear(
-                (&v3(c1f), &v3(c2f)),
-                (&v3(v1f), &v3(v2f)),
-                (r1f as f32, r2f as f32),
-                sign as f32,
-                f32::INFINITY,
-            ) {
+            if certainly_clear(&(v3(c2f) - v3(c1f)), &(v3(v2f) - v3(v1f)), r1f as f32 + r2f as f32, sign as f32, f32::INFINITY) {
                 prop_assert!(e.h > 0 || e.disc < 0, "{e:?}");
             }
             let e = exact(d(c1, c2), d(v1, v2).map(|x| x * sign), r1 + r2);
             let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
-            if certainly_clear((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1 as f64, r2 as f64), sign as f64, f64::INFINITY) {
+            if certainly_clear(&(v3(c2) - v3(c1)), &(v3(v2) - v3(v1)), r1 as f64 + r2 as f64, sign as f64, f64::INFINITY) {
                 prop_assert!(e.h > 0 || e.disc < 0, "{e:?}");
             }
         }
@@ -675,15 +664,15 @@ mod tests {
                 let claimed = if single {
                     let v = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
                     certainly_clear(
-                        (&v(f(c1)), &v(f(c2))),
-                        (&v(f(v1)), &v(f(v2))),
-                        (r1 as f32, r2 as f32),
+                        &(v(f(c2)) - v(f(c1))),
+                        &(v(f(v2)) - v(f(v1))),
+                        r1 as f32 + r2 as f32,
                         1.0,
                         horizon as f32,
                     )
                 } else {
                     let v = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
-                    certainly_clear((&v(c1), &v(c2)), (&v(v1), &v(v2)), (r1 as f64, r2 as f64), 1.0, horizon)
+                    certainly_clear(&(v(c2) - v(c1)), &(v(v2) - v(v1)), r1 as f64 + r2 as f64, 1.0, horizon)
                 };
                 prop_assert!(!claimed || clear, "f32 {single}: {e:?} H = {horizon} t1 = {t1}");
             }
@@ -719,19 +708,13 @@ mod tests {
                 let (r1, r2) = ((r / 2) as f32 as i64, (r - r / 2) as f32 as i64);
                 let e = exact(d(f(c1), f(c2)), d(f(v1), f(v2)).map(|x| x * sign), r1 + r2);
                 let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f32));
-                if certainly_clear(
-                    (&v3(c1), &v3(c2)),
-                    (&v3(v1), &v3(v2)),
-                    (r1 as f32, r2 as f32),
-                    sign as f32,
-                    f32::INFINITY,
-                ) {
+                if certainly_clear(&(v3(c2) - v3(c1)), &(v3(v2) - v3(v1)), r1 as f32 + r2 as f32, sign as f32, f32::INFINITY) {
                     prop_assert!(e.h > 0 || e.disc < 0, "f32 {e:?}");
                 }
                 let e = exact(u, w.map(|x| x * sign), r);
                 let v3 = |x: [i64; 3]| Vector3::from(x.map(|v| v as f64));
                 let (r1, r2) = ((r / 2) as f64, (r - r / 2) as f64);
-                if certainly_clear((&v3(c1), &v3(c2)), (&v3(v1), &v3(v2)), (r1, r2), sign as f64, f64::INFINITY) {
+                if certainly_clear(&(v3(c2) - v3(c1)), &(v3(v2) - v3(v1)), r1 + r2, sign as f64, f64::INFINITY) {
                     prop_assert!(e.h > 0 || e.disc < 0, "f64 {e:?}");
                 }
             }
