@@ -72,13 +72,28 @@ impl<const D: usize> GridIndex<D> {
         index as usize
     }
 
+    /// `true` if no neighbour of cell `base` is past an edge of the grid.
+    #[inline]
+    pub(crate) fn is_interior(&self, base: [i64; D]) -> bool {
+        (0..D).all(|k| base[k] >= 1 && base[k] + 2 <= self.counts[k])
+    }
+
+    /// `true` if points in the cells around the interior cell `base` are each other's
+    /// minimum images as they are: every cell around it is inside the grid, so nothing
+    /// wrapped them, and they are less than two cells apart on every axis, at most half
+    /// a period when every axis has four cells or more.
+    #[inline]
+    pub(crate) fn needs_no_image(&self, base: [i64; D]) -> bool {
+        self.is_interior(base) && self.counts.iter().all(|&n| n >= 4)
+    }
+
     /// Writes the cells around the (in-grid) cell `base`, itself included and each once,
     /// to the start of `around`; returns their number.
     #[inline]
     pub(crate) fn around(&self, base: [i64; D], around: &mut [usize; MAX_AROUND]) -> usize {
         let cells = Self::around_count();
         // An interior cell's neighbours are at fixed index offsets, all distinct.
-        if (0..D).all(|k| base[k] >= 1 && base[k] + 2 <= self.counts[k]) {
+        if self.is_interior(base) {
             let index = self.index(base) as i64;
             for (slot, delta) in around.iter_mut().zip(&self.offsets[..cells]) {
                 *slot = (index + delta) as usize;

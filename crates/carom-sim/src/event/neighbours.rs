@@ -164,7 +164,8 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
         let mut around = [0; MAX_AROUND];
         for i in 0..n {
             let count = lists.cells_around(&lists.balls[i].anchor, &mut around);
-            lists.collect_partners(i, &around[..count], true);
+            let image = lists.image_around(&lists.balls[i].anchor);
+            lists.collect_partners(i, &around[..count], true, image);
         }
         lists
     }
@@ -227,12 +228,30 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
         let c = self.cell_index(&position);
         self.members.push(c, i as u32);
         self.cell_of[i] = c as u32;
-        self.collect_partners(i, &around[..count], false);
+        let image = self.image_around(&position);
+        self.collect_partners(i, &around[..count], false, image);
     }
 
-    /// Finds the partners of `i` in the cells `around` its anchor. With `only_higher`
-    /// (the initial build) each pair is found once from its lower index.
-    fn collect_partners(&mut self, i: usize, around: &[usize], only_higher: bool) {
+    /// The periods for minimum images between the anchor at `p` and anchors in the cells
+    /// around it: none when they cannot wrap (an interior cell of a grid of four cells or
+    /// more per axis, most of them in a large box), so the rebuild skips the comparisons.
+    fn image_around(&self, p: &Vector<T, D>) -> Option<Period<T, D>> {
+        match &self.cells {
+            Cells::Direct { grid, .. } if grid.needs_no_image(self.cell_coords(p)) => None,
+            _ => self.period,
+        }
+    }
+
+    /// Finds the partners of `i` in the cells `around` its anchor, separations taken as
+    /// minimum images over `image`. With `only_higher` (the initial build) each pair is
+    /// found once from its lower index.
+    fn collect_partners(
+        &mut self,
+        i: usize,
+        around: &[usize],
+        only_higher: bool,
+        image: Option<Period<T, D>>,
+    ) {
         let Anchored { anchor: a, radius } = self.balls[i];
         // The candidates' anchors are misses of their own: asked for all at once first.
         self.candidates.clear();
@@ -250,7 +269,7 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
             let other = &self.balls[j as usize];
             let within = radius + other.radius + shells;
             let d = other.anchor - a;
-            let d = match &self.period {
+            let d = match &image {
                 Some(period) => period.minimum_image(&d),
                 None => d,
             };
