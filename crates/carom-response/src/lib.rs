@@ -9,6 +9,8 @@
 //! * [`resolve`]: the impulse with restitution `e ∈ [0, 1]` and optional Coulomb friction
 //!   ([`Coefficients`]); returns a [`Response`] with the impulse, the new velocities and
 //!   the change of kinetic energy. Never applied to a receding pair.
+//! * [`central_impulse`]: the same for two smooth balls (no friction), along the line of
+//!   centres, without spins: what an event-driven gas needs per collision.
 //! * [`RigidCluster`]: perfectly inelastic "stick" collisions fuse bodies into one rigid
 //!   body that keeps linear and angular momentum, each ball counting with its own inertia
 //!   (disk `m r²/2` in 2D, solid sphere `2 m r²/5` in 3D).
@@ -47,7 +49,7 @@ pub use cluster::{Fusion, MemberMap, RigidCluster};
 pub use coefficients::Coefficients;
 pub use contact::Contact;
 pub use guard::{Bounce, CollapseGuard, RestingGuard};
-pub use impulse::{Friction, Outcome, Response, normal_velocity, resolve};
+pub use impulse::{Friction, Outcome, Response, central_impulse, normal_velocity, resolve};
 
 /// An angular velocity, momentum or impulse: `Vector1` (the z component) in 2D, `Vector3`
 /// in 3D.

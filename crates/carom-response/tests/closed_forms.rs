@@ -3,7 +3,7 @@
 
 mod common;
 
-use carom_response::{Body, Coefficients, Contact, Outcome, resolve};
+use carom_response::{Body, Coefficients, Contact, Outcome, central_impulse, resolve};
 use common::{TestBall, assert_close};
 use nalgebra::{SVector, Vector1, Vector2, Vector3};
 
@@ -59,6 +59,11 @@ where
                 assert_close(r.velocity[0].as_slice(), (axis * w1).as_slice(), tol, "v1");
                 assert_close(r.velocity[1].as_slice(), (axis * w2).as_slice(), tol, "v2");
                 assert_eq!(r.outcome, Outcome::Applied(carom_response::Friction::None));
+                let [c1, c2] =
+                    central_impulse((1.0 / m1, &(axis * u1)), (1.0 / m2, &(axis * u2)), &axis, e)
+                        .expect("closing head on");
+                assert_close(c1.as_slice(), (axis * w1).as_slice(), tol, "central v1");
+                assert_close(c2.as_slice(), (axis * w2).as_slice(), tol, "central v2");
             }
         }
     }
@@ -400,4 +405,30 @@ fn grazing_contact_gets_a_tiny_impulse_and_stays_finite() {
     );
     assert!((r.tangential_impulse.norm() - 0.5e-12).abs() < 1e-24);
     assert!(r.velocity.iter().all(|v| v.iter().all(|x| x.is_finite())));
+}
+
+#[test]
+fn a_smooth_ball_on_an_immovable_ball_reverses_its_normal_velocity_times_e() {
+    // Ball a (1 kg) hits an immovable ball b obliquely along n = (0.6, 0.8): the normal
+    // component −e v_n comes back, the tangential one stays; b does not move.
+    let n = Vector2::new(0.6, 0.8);
+    let v = Vector2::new(2.0, 1.0);
+    let v_n = v.dot(&n);
+    for e in [0.0, 0.5, 1.0] {
+        let [a, b] = central_impulse((1.0, &v), (0.0, &Vector2::zeros()), &n, e)
+            .expect("closing on the immovable ball");
+        assert_close(
+            a.as_slice(),
+            (v - n * ((1.0 + e) * v_n)).as_slice(),
+            1e-15,
+            "a",
+        );
+        assert_eq!(b, Vector2::zeros());
+    }
+    // No impulse: receding, touching at zero normal speed, or both immovable.
+    let z = Vector2::zeros();
+    assert!(central_impulse((1.0, &-v), (0.0, &z), &n, 1.0).is_none());
+    let tangential = Vector2::new(-0.8, 0.6);
+    assert!(central_impulse((1.0, &tangential), (1.0, &z), &n, 1.0).is_none());
+    assert!(central_impulse((0.0, &v), (0.0, &z), &n, 1.0).is_none());
 }

@@ -2,11 +2,14 @@
 //! and friction, in 2D and 3D: momentum and angular momentum are conserved to 1e-12
 //! relative, kinetic energy never increases (computed from masses and radii here, not
 //! from the response's own bookkeeping), Newton's law holds along the normal, and a
-//! receding pair is never touched.
+//! receding pair is never touched. Without friction, `central_impulse` gives `resolve`'s
+//! velocities to rounding.
 
 mod common;
 
-use carom_response::{Angular, Body, Coefficients, Contact, Friction, Outcome, Space, resolve};
+use carom_response::{
+    Angular, Body, Coefficients, Contact, Friction, Outcome, Space, central_impulse, resolve,
+};
 use common::{TestBall, angular};
 use nalgebra::{Const, Matrix3, SVector, Vector1, Vector2, Vector3};
 use proptest::prelude::*;
@@ -75,6 +78,30 @@ where
         - a.velocity
         - <Const<D> as Space<f64, D>>::angular_cross(&a.spin, &contact.offset_a()))
     .dot(&contact.normal());
+    if mu == 0.0 {
+        // The smooth-ball shortcut: no impulse exactly when `resolve` applies none, and
+        // otherwise the same velocities to rounding.
+        let central = central_impulse(
+            (1.0 / a.mass, &a.velocity),
+            (1.0 / b.mass, &b.velocity),
+            &contact.normal(),
+            e,
+        );
+        prop_assert_eq!(central.is_some(), r.applied(), "{:?}", r.outcome);
+        if let Some([va, vb]) = central {
+            let scale = a.velocity.norm() + b.velocity.norm();
+            prop_assert!(
+                (va - r.velocity[0]).norm() <= 1e-13 * scale,
+                "{va} vs {}",
+                r.velocity[0]
+            );
+            prop_assert!(
+                (vb - r.velocity[1]).norm() <= 1e-13 * scale,
+                "{vb} vs {}",
+                r.velocity[1]
+            );
+        }
+    }
     if v_n > 0.0 {
         prop_assert_eq!(r.outcome, Outcome::Receding);
         prop_assert_eq!(r.velocity, [a.velocity, b.velocity]);

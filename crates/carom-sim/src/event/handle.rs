@@ -9,7 +9,9 @@
 
 use carom_geometry::query::PointQuery;
 use carom_math::{Real, Space, Vector};
-use carom_response::{Body, Bounce, Coefficients, Contact, normal_velocity, resolve};
+use carom_response::{
+    Body, Bounce, Coefficients, Contact, central_impulse, normal_velocity, resolve,
+};
 use nalgebra::Const;
 
 use super::state::{Mode, Support};
@@ -167,34 +169,54 @@ where
         self.sync_ball(i);
         self.sync_ball(j);
         let ci = self.balls.motion[i].pos;
-        let cj = ci + self.separation(&ci, &self.balls.motion[j].pos);
-        let (ri, rj) = (self.balls.motion[i].radius, self.balls.motion[j].radius);
-        let Ok(contact) = Contact::between_balls(&ci, ri, &cj, rj) else {
-            // Coincident centres cannot come from a predicted contact of positive radii.
-            return;
-        };
-        let (a, b) = (self.ball_body(i), self.ball_body(j));
-        let approach = -normal_velocity(&a, &b, &contact);
+        let offset = self.separation(&ci, &self.balls.motion[j].pos);
         let nominal = self.ball_restitution(i).min(self.ball_restitution(j));
         let since = [
             self.now - self.balls.props[i].last_collision,
             self.now - self.balls.props[j].last_collision,
         ];
-        let e = self.collapse.restitution(nominal, approach, since);
-        let response = resolve(
-            &a,
-            &b,
-            &contact,
-            &Coefficients::new_unchecked(e, self.friction),
-        );
-        if !response.applied() {
-            return;
-        }
-        self.balls.motion[i].vel = response.velocity[0];
-        self.balls.motion[j].vel = response.velocity[1];
-        // Without friction the impulse is central and cannot spin a ball; keeping the spin
-        // as it is avoids the rounding of r × n (1e-17, not exactly 0).
-        if self.friction > T::zero() {
+        if self.friction == T::zero() {
+            // Smooth balls: the central impulse, no spin (carom-response's
+            // `central_impulse`, `resolve` to rounding).
+            let distance = offset.norm();
+            if !(distance > T::zero() && distance.finite()) {
+                // Coincident centres cannot come from a predicted contact of positive radii.
+                return;
+            }
+            let normal = offset / distance;
+            let (vi, vj) = (self.balls.motion[i].vel, self.balls.motion[j].vel);
+            let approach = -(vj - vi).dot(&normal);
+            let e = self.collapse.restitution(nominal, approach, since);
+            let masses = (
+                T::one() / self.balls.props[i].mass,
+                T::one() / self.balls.props[j].mass,
+            );
+            let Some([vi, vj]) = central_impulse((masses.0, &vi), (masses.1, &vj), &normal, e)
+            else {
+                return;
+            };
+            self.balls.motion[i].vel = vi;
+            self.balls.motion[j].vel = vj;
+        } else {
+            let (ri, rj) = (self.balls.motion[i].radius, self.balls.motion[j].radius);
+            let Ok(contact) = Contact::between_balls(&ci, ri, &(ci + offset), rj) else {
+                // Coincident centres cannot come from a predicted contact of positive radii.
+                return;
+            };
+            let (a, b) = (self.ball_body(i), self.ball_body(j));
+            let approach = -normal_velocity(&a, &b, &contact);
+            let e = self.collapse.restitution(nominal, approach, since);
+            let response = resolve(
+                &a,
+                &b,
+                &contact,
+                &Coefficients::new_unchecked(e, self.friction),
+            );
+            if !response.applied() {
+                return;
+            }
+            self.balls.motion[i].vel = response.velocity[0];
+            self.balls.motion[j].vel = response.velocity[1];
             self.balls.props[i].spin = response.angular_velocity[0];
             self.balls.props[j].spin = response.angular_velocity[1];
         }
