@@ -308,37 +308,10 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         upper: bool,
         mut f: impl FnMut(usize),
     ) {
-        let base = self.cell(i);
-        let periodic = self.period.is_some();
-        let mut seen = [0usize; MAX_AROUND];
-        let mut count = 0;
-        'offsets: for offset in 0..3usize.pow(D as u32 - 1) {
-            let mut rest = offset;
-            let mut c = [0i64; D];
-            for (k, ck) in c.iter_mut().enumerate() {
-                let o = if k == axis {
-                    if upper { 1 } else { -1 }
-                } else {
-                    let o = (rest % 3) as i64 - 1;
-                    rest /= 3;
-                    o
-                };
-                let mut x = base[k] + o;
-                let n = self.grid.counts()[k];
-                if x < 0 || x >= n {
-                    if !periodic {
-                        continue 'offsets;
-                    }
-                    x = x.rem_euclid(n);
-                }
-                *ck = x;
-            }
-            let index = self.grid.index(c);
-            if !seen[..count].contains(&index) {
-                seen[count] = index;
-                count += 1;
-                self.members.of(index).for_each(|j| f(j as usize));
-            }
+        let mut slab = [0usize; MAX_AROUND];
+        let count = self.grid.slab(self.cell(i), axis, upper, &mut slab);
+        for &c in &slab[..count] {
+            self.members.of(c).for_each(|j| f(j as usize));
         }
     }
 

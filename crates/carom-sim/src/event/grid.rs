@@ -23,7 +23,14 @@ pub(crate) struct GridIndex<const D: usize> {
     periodic: bool,
     /// The linear-index offsets of the `3^D` cells around an interior cell.
     offsets: [i64; MAX_AROUND],
+    /// Per face `2 · axis + upper`, the linear-index offsets of the `3^(D−1)` cells one
+    /// step across that face from an interior cell (the slab a ball's neighbourhood gains
+    /// when it crosses into the cell through the opposite face).
+    slabs: [[i64; MAX_SLAB]; 6],
 }
+
+/// The most cells in a slab (`3^(D−1)` for `D <= 3`).
+const MAX_SLAB: usize = 9;
 
 impl<const D: usize> GridIndex<D> {
     /// A grid with `counts[k] >= 1` cells on axis `k`.
@@ -38,11 +45,41 @@ impl<const D: usize> GridIndex<D> {
                 stride *= count;
             }
         }
+        let mut slabs = [[0; MAX_SLAB]; 6];
+        for axis in 0..D {
+            for (upper, step) in [(0, -1i64), (1, 1)] {
+                for (slot, delta) in slabs[2 * axis + upper]
+                    .iter_mut()
+                    .enumerate()
+                    .take(Self::slab_count())
+                {
+                    let (mut rest, mut stride) = (slot, 1i64);
+                    for (k, count) in counts.iter().enumerate() {
+                        let o = if k == axis {
+                            step
+                        } else {
+                            let o = (rest % 3) as i64 - 1;
+                            rest /= 3;
+                            o
+                        };
+                        *delta += o * stride;
+                        stride *= count;
+                    }
+                }
+            }
+        }
         Self {
             counts,
             periodic,
             offsets,
+            slabs,
         }
+    }
+
+    /// `3^(D−1)`.
+    #[inline]
+    const fn slab_count() -> usize {
+        3usize.pow(D as u32 - 1)
     }
 
     /// `3^D`.
@@ -103,6 +140,86 @@ impl<const D: usize> GridIndex<D> {
         self.around_edge(base, around)
     }
 
+    /// Writes the cells one step across the face (`axis`, `upper`) of cell `base` and
+    /// beside that (the `3^(D−1)` cells of the neighbourhood of `base` with that
+    /// coordinate on `axis`), each once, to the start of `out`; returns their number. In
+    /// the order of [`around`](Self::around), the other axes' offsets first axis fastest.
+    #[inline]
+    pub(crate) fn slab(
+        &self,
+        base: [i64; D],
+        axis: usize,
+        upper: bool,
+        out: &mut [usize; MAX_AROUND],
+    ) -> usize {
+        if self.is_interior(base) {
+            let index = self.index(base) as i64;
+            let slab = &self.slabs[2 * axis + usize::from(upper)];
+            for (slot, delta) in out.iter_mut().zip(&slab[..Self::slab_count()]) {
+                *slot = (index + delta) as usize;
+            }
+            return Self::slab_count();
+        }
+        self.slab_edge(base, axis, upper, out)
+    }
+
+    /// [`slab`](Self::slab) for a cell on the grid's edge, out of line, as
+    /// [`around_edge`](Self::around_edge) with `axis` held one step across the face.
+    #[inline(never)]
+    fn slab_edge(
+        &self,
+        base: [i64; D],
+        axis: usize,
+        upper: bool,
+        out: &mut [usize; MAX_AROUND],
+    ) -> usize {
+        let mut values = [[0i64; 3]; D];
+        let mut lens = [0usize; D];
+        for k in 0..D {
+            let n = self.counts[k];
+            let steps: &[i64] = match (k == axis, upper) {
+                (true, true) => &[1],
+                (true, false) => &[-1],
+                (false, _) => &[-1, 0, 1],
+            };
+            for &o in steps {
+                let mut x = base[k] + o;
+                if x < 0 || x >= n {
+                    if !self.periodic {
+                        continue;
+                    }
+                    x = x.rem_euclid(n);
+                }
+                if !values[k][..lens[k]].contains(&x) {
+                    values[k][lens[k]] = x;
+                    lens[k] += 1;
+                }
+            }
+        }
+        self.combinations(&values, &lens, out)
+    }
+
+    /// Every combination of the per-axis coordinates `values[k][..lens[k]]`, first axis
+    /// fastest, as linear indices written to `out`; returns their number.
+    fn combinations(
+        &self,
+        values: &[[i64; 3]; D],
+        lens: &[usize; D],
+        out: &mut [usize; MAX_AROUND],
+    ) -> usize {
+        let total: usize = lens.iter().product();
+        for (slot, cell) in out.iter_mut().enumerate().take(total) {
+            let mut rest = slot;
+            let c: [i64; D] = core::array::from_fn(|k| {
+                let x = values[k][rest % lens[k]];
+                rest /= lens[k];
+                x
+            });
+            *cell = self.index(c);
+        }
+        total
+    }
+
     /// [`around`](Self::around) for a cell on the grid's edge, out of line: per axis the
     /// coordinates `x − 1, x, x + 1` that exist (wrapped on a periodic axis, dropped past
     /// a wall, each value once on an axis of one or two cells), then every combination,
@@ -127,17 +244,7 @@ impl<const D: usize> GridIndex<D> {
                 }
             }
         }
-        let total: usize = lens.iter().product();
-        for (slot, out) in around.iter_mut().enumerate().take(total) {
-            let mut rest = slot;
-            let c: [i64; D] = core::array::from_fn(|k| {
-                let x = values[k][rest % lens[k]];
-                rest /= lens[k];
-                x
-            });
-            *out = self.index(c);
-        }
-        total
+        self.combinations(&values, &lens, around)
     }
 }
 
@@ -229,6 +336,75 @@ mod tests {
                 base[k] = 0;
                 k += 1;
             }
+        }
+    }
+
+    /// The slab across face (`axis`, `upper`) of `base`, offset by offset as the cells
+    /// code enumerated it before this module.
+    fn slab_by_offsets<const D: usize>(
+        grid: &GridIndex<D>,
+        base: [i64; D],
+        axis: usize,
+        upper: bool,
+    ) -> Vec<usize> {
+        let mut out = Vec::new();
+        'offsets: for offset in 0..3usize.pow(D as u32 - 1) {
+            let mut rest = offset;
+            let mut c = [0i64; D];
+            for k in 0..D {
+                let o = if k == axis {
+                    if upper { 1 } else { -1 }
+                } else {
+                    let o = (rest % 3) as i64 - 1;
+                    rest /= 3;
+                    o
+                };
+                let (n, mut x) = (grid.counts[k], base[k] + o);
+                if x < 0 || x >= n {
+                    if !grid.periodic {
+                        continue 'offsets;
+                    }
+                    x = x.rem_euclid(n);
+                }
+                c[k] = x;
+            }
+            if !out.contains(&grid.index(c)) {
+                out.push(grid.index(c));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn the_slab_across_each_face_of_every_cell_is_listed_each_once_in_one_order() {
+        fn each<const D: usize>(counts: [i64; D], periodic: bool) {
+            let grid = GridIndex::new(counts, periodic);
+            let total = grid.len();
+            for index in 0..total {
+                let mut rest = index as i64;
+                let base: [i64; D] = core::array::from_fn(|k| {
+                    let x = rest % counts[k];
+                    rest /= counts[k];
+                    x
+                });
+                for axis in 0..D {
+                    for upper in [false, true] {
+                        let mut out = [0; MAX_AROUND];
+                        let n = grid.slab(base, axis, upper, &mut out);
+                        assert_eq!(
+                            &out[..n],
+                            &slab_by_offsets(&grid, base, axis, upper)[..],
+                            "{counts:?} periodic {periodic} {base:?} axis {axis} upper {upper}"
+                        );
+                    }
+                }
+            }
+        }
+        for periodic in [false, true] {
+            each([5, 4], periodic);
+            each([2, 7], periodic);
+            each([4, 3, 5], periodic);
+            each([1, 2, 6], periodic);
         }
     }
 
