@@ -81,8 +81,9 @@ pub struct CellLists<T: Real, const D: usize> {
     origin: Vector<T, D>,
     /// The width of the cells per axis (each axis is cut into whole cells).
     width: Vector<T, D>,
-    /// The grid's shape: cells per axis, neighbourhoods.
-    grid: GridIndex<D>,
+    /// The grid's shape: cells per axis, neighbourhoods (boxed: its tables of offsets are
+    /// large beside the engine's other ways of finding partners).
+    grid: Box<GridIndex<D>>,
     /// The periodic box, for minimum images and wrapping cell coordinates.
     period: Option<Border<T, D>>,
     /// The balls in each cell.
@@ -116,7 +117,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         let counts: [i64; D] =
             core::array::from_fn(|k| ((ext[k] / cell).floor().to_f64() as i64).max(1));
         let width = Vector::<T, D>::from_fn(|k, _| ext[k] / T::from_count(counts[k] as usize));
-        let grid = GridIndex::new(counts, periodic);
+        let grid = Box::new(GridIndex::new(counts, periodic));
         let mut cells = Self {
             origin: min,
             width,
