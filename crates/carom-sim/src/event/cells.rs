@@ -28,7 +28,7 @@
 //! Cells on the edge of a walled box extend to infinity outwards (no crossing leaves the
 //! grid), so a ball starting partly outside the border still has its neighbours.
 
-use carom_geometry::Border;
+use carom_geometry::{Border, Period};
 use carom_math::{Real, Vector, floor_to_i64};
 use carom_toi::{Direction, Window, level_crossing};
 
@@ -85,7 +85,10 @@ pub struct CellLists<T: Real, const D: usize> {
     /// large beside the engine's other ways of finding partners).
     grid: Box<GridIndex<D>>,
     /// The periodic box, for minimum images and wrapping cell coordinates.
-    period: Option<Border<T, D>>,
+    period: Option<Period<T, D>>,
+    /// Per axis, how far inside an open face a ball's offset is clamped before its
+    /// crossing is computed (`FACE_INSET` of the width, and at least 16 ulps).
+    inset: Vector<T, D>,
     /// The balls in each cell.
     members: IdRows<CELL_ROW, Quarter>,
     /// Each ball's cell and scheduled times.
@@ -123,7 +126,12 @@ impl<T: Real, const D: usize> CellLists<T, D> {
             width,
             members: IdRows::new(grid.len()),
             grid,
-            period: periodic.then(|| Border::new(min, max).expect("a periodic box is a valid box")),
+            period: periodic.then(|| {
+                Border::new(min, max)
+                    .expect("a periodic box is a valid box")
+                    .period()
+            }),
+            inset: width.map(|w| w * T::lit(FACE_INSET).max(T::lit(16.0) * T::EPSILON)),
             places: Vec::with_capacity(n),
         };
         for (i, p) in positions.iter().enumerate() {
@@ -225,7 +233,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
     ) -> Option<Crossing<T>> {
         let corner = self.corner(i);
         let offset = match &self.period {
-            Some(border) => border.minimum_image(&(position - corner)),
+            Some(period) => period.minimum_image(&(position - corner)),
             None => position - corner,
         };
         let c = self.cell(i);
@@ -233,8 +241,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         let window = Window::unbounded(Direction::Forward);
         let mut first: Option<Crossing<T>> = None;
         for k in 0..D {
-            let w = self.width[k];
-            let inset = w * T::lit(FACE_INSET).max(T::lit(16.0) * T::EPSILON);
+            let (w, inset) = (self.width[k], self.inset[k]);
             let lower_open = periodic || c[k] > 0;
             let upper_open = periodic || c[k] + 1 < self.grid.counts()[k];
             let mut x = offset[k];
