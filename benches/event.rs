@@ -1,8 +1,9 @@
 //! The event-driven engine's throughput: collisions per second on one core.
 //!
 //! Scenes (carom-sim's shared gas generator): 3D hard spheres in a periodic box at
-//! packing fraction 0.45 (N = 32,000: the target, beside Smallenburg's EDMD at
-//! 0.35–0.42 M collisions/s on this kind of machine) and 2D discs at area fraction 0.3
+//! packing fraction 0.45 (N = 32,000: the target, beside Smallenburg's EDMD,
+//! measured at 0.80–0.86 M collisions/s on this project's VM, docs/event-engine.md) and
+//! 2D discs at area fraction 0.3
 //! (N = 100,000). Each gas is first run for two time units so the lattice start has
 //! relaxed; then each criterion iteration advances it by a fixed time span whose
 //! collision count is measured beforehand (stable to about 1 % at these sizes), which

@@ -405,8 +405,9 @@ fn event_table(md: &mut String, report: &Report) {
         md,
         "How to read: ball–ball collisions per second of wall-clock time on one core, median \
          of several spans after the gas relaxed from its lattice start; the targets are the \
-         event-driven engine issue's, EDMD (Smallenburg 2022) does 0.35–0.42 M/s in 3D on \
-         this kind of machine. Energy drift over the whole run should be rounding only.\n"
+         event-driven engine issue's; EDMD (Smallenburg 2022, its published code) did \
+         0.80–0.86 M/s in 3D at N = 32,000 on this project's VM (measured 2026-11-24, see \
+         docs/event-engine.md). Energy drift over the whole run should be rounding only.\n"
     );
     let _ = writeln!(
         md,
