@@ -83,6 +83,25 @@ impl Integrator {
         }
     }
 
+    /// How a step shows a constant acceleration `a` in its mean velocity: the step from
+    /// `(x₀, v₀)` is `x₁ = x₀ + h (v₀ + w a h)`, `v₁ = v₀ + a h` with this weight `w` —
+    /// `0` for explicit Euler (the position moves with the old velocity), `1` for
+    /// semi-implicit Euler (with the new one), `½` for Verlet, RK4 and the exact
+    /// integrator (exact for constant acceleration). So a force held constant over a step
+    /// changes the step's chord `(x₁ − x₀)/h` by `w` times what it adds to the end
+    /// velocity: the time-stepped engine turns a correction of a chord into the end
+    /// velocity of the constant contact force that makes it (`w > 0`), and corrects
+    /// explicit Euler's chords with impulses instead (`w = 0`: no force within the step
+    /// moves them). With velocity-dependent forces (drag) the relation holds to first
+    /// order in the step.
+    pub const fn chord_weight(self) -> f64 {
+        match self {
+            Integrator::ExplicitEuler => 0.0,
+            Integrator::SemiImplicitEuler => 1.0,
+            Integrator::VelocityVerlet | Integrator::Rk4 | Integrator::Exact => 0.5,
+        }
+    }
+
     /// Force-field evaluations per ball per step.
     pub const fn evaluations_per_step(self) -> usize {
         match self {
@@ -162,6 +181,30 @@ mod tests {
         );
         assert!("euler".parse::<Integrator>().is_err());
         assert!("".parse::<Integrator>().is_err());
+    }
+
+    #[test]
+    fn the_chord_weight_is_what_each_scheme_does_with_a_constant_acceleration() {
+        use crate::{Bodies, Gravity, Stepper, TimeStep};
+        use nalgebra::Vector2;
+        // One step under constant gravity from (x₀, v₀): (x₁ − x₀)/h − v₀ = w a h.
+        let a = Vector2::new(0.0, -9.81);
+        let (x0, v0, h) = (Vector2::new(0.3, 2.0), Vector2::new(1.5, 0.7), 0.01);
+        for integrator in Integrator::ALL {
+            let stepper = Stepper::new(integrator, Gravity::new(a).unwrap()).unwrap();
+            let (mut x, mut v) = ([x0], [v0]);
+            let mut bodies = Bodies::new(&mut x, &mut v, &[1.0]).unwrap();
+            stepper.step(&mut bodies, 0.0, TimeStep::new(h).unwrap());
+            let w = ((x[0] - x0) / h - v0).y / (a.y * h);
+            assert!(
+                (w - integrator.chord_weight()).abs() < 1e-12,
+                "{integrator}: {w}"
+            );
+            assert!(
+                ((v[0] - v0) - a * h).norm() < 1e-15,
+                "{integrator}: v₁ = v₀ + a h"
+            );
+        }
     }
 
     #[test]

@@ -222,6 +222,23 @@ where
         self.pos[i] = self.seg_x[i] + u * (h - self.seg_t[i]);
     }
 
+    /// Sets the segment of ball `i` from its start on: the velocity at its start, its
+    /// chord and its end velocity `[seg_v, chord, vel]`, its start and end spins.
+    pub(crate) fn set_segment(
+        &mut self,
+        i: usize,
+        h: T,
+        [seg_v, chord, vel]: [Vector<T, D>; 3],
+        [seg_w, spin]: [Angular<T, D>; 2],
+    ) {
+        self.seg_v[i] = seg_v;
+        self.chord[i] = chord;
+        self.vel[i] = vel;
+        self.seg_w[i] = seg_w;
+        self.spin[i] = spin;
+        self.pos[i] = self.seg_x[i] + chord * (h - self.seg_t[i]);
+    }
+
     /// Changes the chord of ball `i` by `du` (and its spin by `dw`) from the segment start
     /// on, for a resting contact along the unit normal `n`: the physical velocity shifts
     /// by the same amount over the whole segment, and its component along `n` becomes the

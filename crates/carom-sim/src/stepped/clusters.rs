@@ -19,6 +19,16 @@
 //! tested against each other. At every step end the members are exactly (to rounding) in
 //! their rigid places, so the distances between them are kept.
 //!
+//! **A held segment.** Contacts that hold a cluster (see `stack`) act as a constant force
+//! and torque over its segment, kept as its *push*: the change they make to the
+//! segment's mean motion, `(Δv, ΔL)`. The pose follows the *drive*, the start's motion
+//! plus the push; the end's motion has the push `1/w` times, `w` the integrator's chord
+//! weight (`Integrator::chord_weight`: a constant acceleration `a` moves the chord by
+//! `w a τ` and the end velocity by `a τ`); the start's motion has none of it. Within the
+//! segment the motion is interpolated linearly between the start's and the end's, as a
+//! ball's velocity is (`balls`): exact for a constant force, so a cluster restarted
+//! within a held segment is at rest if it rests, not flying up at the push.
+//!
 //! **The motion over a segment of length `τ`** ([`advance`]):
 //!
 //! * the centre of mass is stepped by the engine's integrator under the same field as a
@@ -57,16 +67,15 @@ pub(crate) struct StuckCluster<T: Real, const D: usize>
 where
     Const<D>: Space<T, D>,
 {
-    /// The rigid state at the segment start `seg_t`.
+    /// The rigid state at the segment start `seg_t`: pose and physical motion.
     pub(crate) start: RigidCluster<T, D>,
+    /// The constant contact force held over the segment, as the change it makes to the
+    /// segment's mean motion (see the module documentation).
+    pub(crate) push: Motion<T, D>,
     /// The in-step time the segment starts at.
     pub(crate) seg_t: T,
     /// The rigid state at the end of the step (the state between steps).
     pub(crate) end: RigidCluster<T, D>,
-    /// Momentum added to the end state only, in this step: the reaction of a ball
-    /// resting on the cluster to the end of its own step (see `stick`'s `load_cluster`),
-    /// kept when the step is integrated again.
-    pub(crate) kick: Vector<T, D>,
     /// The member balls.
     pub(crate) members: Vec<u32>,
     /// Their offsets from the centre of mass, in the body frame.
@@ -86,6 +95,41 @@ where
     /// The smallest side of a periodic border: a cluster may span at most half of it
     /// (see [`Clusters::check_span`]).
     pub(crate) period: Option<T>,
+    /// The integrator's chord weight `w` (`Integrator::chord_weight`): a held segment's
+    /// end motion has its push `1/w` times (see the module documentation).
+    pub(crate) chord_weight: T,
+}
+
+/// A change of a rigid body's motion: the velocity of its centre of mass and its angular
+/// momentum about the centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Motion<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    pub(crate) velocity: Vector<T, D>,
+    pub(crate) momentum: Angular<T, D>,
+}
+
+impl<T: Real, const D: usize> Motion<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// No change.
+    pub(crate) fn zero() -> Self {
+        Self {
+            velocity: Vector::zeros(),
+            momentum: <Const<D> as Space<T, D>>::angular_zero(),
+        }
+    }
+
+    /// `rigid` with this change of its motion, `k` times.
+    pub(crate) fn added(&self, rigid: &RigidCluster<T, D>, k: T) -> RigidCluster<T, D> {
+        rigid.with_motion(
+            rigid.velocity() + self.velocity * k,
+            rigid.angular_momentum() + self.momentum * k,
+        )
+    }
 }
 
 /// The arm `R o` of a member and its velocity `v + ω × R o` on `rigid`.
@@ -159,9 +203,16 @@ impl<T: Real, const D: usize> StuckCluster<T, D>
 where
     Const<D>: Space<T, D>,
 {
+    /// The motion the pose follows over the segment: the start's plus the push.
+    pub(crate) fn drive(&self) -> RigidCluster<T, D> {
+        self.push.added(&self.start, T::one())
+    }
+
     /// The rigid state at in-step time `s >= seg_t` of a step of length `h` (that started
-    /// at internal time `t0`): velocity, angular momentum and orientation advanced from
-    /// the segment start, the centre of mass on the chord between the segment's ends.
+    /// at internal time `t0`): the orientation advanced along the drive, the centre of
+    /// mass on the chord between the segment's ends, the motion interpolated linearly
+    /// between the start's and the end's (see the module documentation); and the drive's
+    /// motion there less that motion (the push of the rest of the segment).
     ///
     /// The centre is where the members' chords put it (the mass-weighted mean of their
     /// positions on their chords), as a ball restarts on its chord (`BallArrays::restart`):
@@ -169,19 +220,19 @@ where
     /// `|g| τ²/8` under gravity, τ the segment's length: 3.4e-4 m at `h = 1/60 s`), and a
     /// cluster restarted there at a contact jumped by that much, away from a support it
     /// rests on (hovering, then falling onto it again every step) or into it.
-    pub(crate) fn at<F: ForceField<T, D>>(
+    fn state_at<F: ForceField<T, D>>(
         &self,
         s: T,
         h: T,
         stepper: &Stepper<T, D, F>,
         drag: T,
         t0: T,
-    ) -> RigidCluster<T, D> {
+    ) -> (RigidCluster<T, D>, Motion<T, D>) {
         if s <= self.seg_t {
-            return self.start;
+            return (self.start, self.push);
         }
-        let moved = advance(
-            &self.start,
+        let drive = advance(
+            &self.drive(),
             &self.offsets,
             stepper,
             drag,
@@ -190,10 +241,57 @@ where
         );
         let span = h - self.seg_t;
         if span <= T::zero() {
-            return moved;
+            return (drive, Motion::zero());
         }
-        let (a, b) = (self.start.center(), self.end.center());
-        moved.with_pose(a + (b - a) * ((s - self.seg_t) / span), moved.orientation())
+        let f = ((s - self.seg_t) / span).min(T::one());
+        let (a, b) = (&self.start, &self.end);
+        let rigid = drive
+            .with_pose(
+                a.center() + (b.center() - a.center()) * f,
+                drive.orientation(),
+            )
+            .with_motion(
+                a.velocity() + (b.velocity() - a.velocity()) * f,
+                a.angular_momentum() + (b.angular_momentum() - a.angular_momentum()) * f,
+            );
+        let push = Motion {
+            velocity: drive.velocity() - rigid.velocity(),
+            momentum: drive.angular_momentum() - rigid.angular_momentum(),
+        };
+        (rigid, push)
+    }
+
+    /// The rigid state at in-step time `s` (see [`Self::state_at`]).
+    pub(crate) fn at<F: ForceField<T, D>>(
+        &self,
+        s: T,
+        h: T,
+        stepper: &Stepper<T, D, F>,
+        drag: T,
+        t0: T,
+    ) -> RigidCluster<T, D> {
+        self.state_at(s, h, stepper, drag, t0).0
+    }
+
+    /// Restarts the segment at `s` on the same motion: it starts from the state there,
+    /// the push is what the drive has beyond it, the end is unchanged; the members
+    /// restart on their chords. Returns the state at `s`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn restart_at<F: ForceField<T, D>>(
+        &mut self,
+        balls: &mut BallArrays<T, D>,
+        s: T,
+        h: T,
+        stepper: &Stepper<T, D, F>,
+        drag: T,
+        t0: T,
+    ) -> RigidCluster<T, D> {
+        let (rigid, push) = self.state_at(s, h, stepper, drag, t0);
+        self.restart_members(balls, &rigid, s, h);
+        self.start = rigid;
+        self.push = push;
+        self.seg_t = s;
+        rigid
     }
 
     /// Starts a new segment at `s` from the rigid state `rigid` (the state at `s`,
@@ -214,9 +312,31 @@ where
         self.restart_members(balls, &rigid, s, h);
         self.start = rigid;
         self.seg_t = s;
-        let end = advance(&rigid, &self.offsets, stepper, drag, t0 + s, h - s);
-        let kicked = end.velocity() + self.kick / end.mass();
-        self.end = end.with_motion(kicked, end.angular_momentum());
+        self.hold(balls, Motion::zero(), h, stepper, drag, t0, T::one());
+    }
+
+    /// Holds the segment with the constant force whose push is `push` (see the module
+    /// documentation; `chord_weight` is `w > 0`): the pose follows the drive to the end
+    /// of the step `h`, whose motion has the push `1/w` times; the members' chords follow.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn hold<F: ForceField<T, D>>(
+        &mut self,
+        balls: &mut BallArrays<T, D>,
+        push: Motion<T, D>,
+        h: T,
+        stepper: &Stepper<T, D, F>,
+        drag: T,
+        t0: T,
+        chord_weight: T,
+    ) {
+        self.push = push;
+        let s = self.seg_t;
+        let end = advance(&self.drive(), &self.offsets, stepper, drag, t0 + s, h - s);
+        self.end = if push == Motion::zero() {
+            end
+        } else {
+            push.added(&end, T::one() / chord_weight - T::one())
+        };
         self.set_member_ends(balls, h);
     }
 
@@ -251,12 +371,15 @@ impl<T: Real, const D: usize> Clusters<T, D>
 where
     Const<D>: Space<T, D>,
 {
-    /// No clusters yet, for a run with the signed linear `drag` coefficient.
-    pub(crate) fn new(drag: T, period: Option<T>) -> Self {
+    /// No clusters yet, for a run with the signed linear `drag` coefficient, in a periodic
+    /// border whose smallest side is `period`, with an integrator of chord weight
+    /// `chord_weight`.
+    pub(crate) fn new(drag: T, period: Option<T>, chord_weight: T) -> Self {
         Self {
             list: Vec::new(),
             drag,
             period,
+            chord_weight,
         }
     }
 
@@ -290,7 +413,7 @@ where
             let rigid = cluster.end;
             cluster.start = rigid;
             cluster.seg_t = T::zero();
-            cluster.kick = Vector::zeros();
+            cluster.push = Motion::zero();
             cluster.end = advance(&rigid, &cluster.offsets, stepper, drag, t0, h);
             cluster.set_member_ends(balls, h);
         }
@@ -309,6 +432,7 @@ where
         for cluster in &mut self.list {
             let rigid = cluster.at(s, h, stepper, drag, t0);
             cluster.start = rigid;
+            cluster.push = Motion::zero();
             cluster.seg_t = s;
             cluster.end = rigid;
         }
@@ -328,19 +452,17 @@ where
     ) {
         let drag = self.drag;
         for cluster in &mut self.list {
-            let rigid = cluster.at(s, h, stepper, drag, t0);
-            let c = rigid.center();
+            let c = cluster.at(s, h, stepper, drag, t0).center();
             let shift = border.wrap(&c) - c;
             if shift == Vector::<T, D>::zeros() {
                 continue;
             }
-            cluster.restart_members(balls, &rigid, s, h);
+            let rigid = cluster.restart_at(balls, s, h, stepper, drag, t0);
             for &m in &cluster.members {
                 balls.seg_x[m as usize] += shift;
                 balls.pos[m as usize] += shift;
             }
             cluster.start = rigid.with_pose(c + shift, rigid.orientation());
-            cluster.seg_t = s;
             let end = &cluster.end;
             cluster.end = end.with_pose(end.center() + shift, end.orientation());
         }

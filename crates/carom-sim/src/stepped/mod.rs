@@ -44,11 +44,13 @@ mod balls;
 mod clusters;
 mod escapees;
 mod forces;
+mod lcp;
 mod narrow;
 mod obstacles;
 mod queue;
 mod response;
 mod rest;
+mod stack;
 mod stick;
 mod sweep;
 
@@ -62,11 +64,13 @@ use rayon::prelude::*;
 use self::balls::BallArrays;
 use self::clusters::Clusters;
 use self::forces::WorldForces;
+use self::lcp::Lcp;
 use self::narrow::{Event, Narrow, Overflow, Target};
 use self::obstacles::BoxArrays;
 use self::queue::EventQueue;
 use self::response::{Contacts, Effect, RestSets, Rules, Surface};
-use self::rest::{MemberSupport, Support, Touch};
+use self::rest::{Support, Touch};
+use self::stack::Groups;
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
 
 /// Escapees per parallel task of the step's first predictions (each is a broad-phase
@@ -148,11 +152,10 @@ where
     /// Events of one ball's prediction (scratch).
     found: Vec<Event<T, D>>,
     touches: [Vec<Touch<T, D>>; 2],
-    /// The free balls under the members of the contact's clusters (scratch, see
-    /// [`Self::gather_member_supports`]).
-    member_supports: Vec<MemberSupport<T, D>>,
-    /// The supports of one member in [`Self::gather_member_supports`] (scratch).
-    member_touches: Vec<Touch<T, D>>,
+    /// Scratch of the stacks' complementarity problems (see `stack`).
+    lcp: Lcp<T>,
+    /// The bodies held together in the current step (see `stack`).
+    groups: Groups,
     clock: Clock<T>,
     counters: Counters,
     stats: StepStats,
@@ -243,7 +246,11 @@ where
             stepper,
             rules,
             rest: RestSets::new(n),
-            clusters: Clusters::new(drag, periodic.as_ref().map(|b| b.extents().min())),
+            clusters: Clusters::new(
+                drag,
+                periodic.as_ref().map(|b| b.extents().min()),
+                T::lit(integrator.chord_weight()),
+            ),
             changed: Vec::new(),
             sweep,
             queue: EventQueue::new(),
@@ -252,8 +259,8 @@ where
             candidates: Vec::new(),
             found: Vec::new(),
             touches: [Vec::new(), Vec::new()],
-            member_supports: Vec::new(),
-            member_touches: Vec::new(),
+            lcp: Lcp::default(),
+            groups: Groups::new(n),
             clock: Clock {
                 dt,
                 k: 0,
@@ -393,6 +400,7 @@ where
             return;
         };
         self.rest.clear();
+        self.groups.clear();
         let stepper = &self.stepper;
         // Per chunk: the segments start where the balls are, then the balls are stepped
         // and the chords follow from where they end.
@@ -611,7 +619,8 @@ where
     }
 
     /// Processes one event: the balls it changed go to `self.changed` (a cluster changes
-    /// all its members); returns the collision to report, if any.
+    /// all its members, a hold every ball of its stack); returns the collision to report,
+    /// if any.
     ///
     /// # Errors
     /// A fusion of two clusters that overflows the precision.
@@ -626,21 +635,23 @@ where
         }
         let in_cluster = |b: &BallArrays<T, D>, k: usize| Clusters::of(b, k).is_some();
         let clustered = in_cluster(&self.balls, i) || in_cluster(&self.balls, other);
-        let mut member_supports = core::mem::take(&mut self.member_supports);
-        member_supports.clear();
-        if clustered && self.rules.gravity != Vector::<T, D>::zeros() {
-            self.gather_member_supports(i, other, e.time, &mut member_supports);
-        }
+        let grouped_i = self.groups.grouped(i);
+        self.changed.clear();
         let mut contacts = Contacts {
             balls: &mut self.balls,
+            changed: &mut self.changed,
             boxes: &self.boxes,
             border: self.border.as_ref(),
+            periodic: self.periodic.as_ref(),
+            sweep: &self.sweep,
+            candidates: &mut self.candidates,
+            lcp: &mut self.lcp,
+            groups: &mut self.groups,
             stepper: &self.stepper,
             rules: &self.rules,
             rest: &mut self.rest,
             clusters: &mut self.clusters,
             touching: [(i, &touches[0]), (other, &touches[1])],
-            member_supports: &member_supports,
             h,
             t0,
         };
@@ -655,7 +666,8 @@ where
                 let sticks = self.rules.stick
                     && contacts.balls.restitution[i].min(contacts.balls.restitution[j])
                         == T::zero();
-                let effect = if clustered || sticks {
+                let grouped = contacts.groups.grouped(i) || contacts.groups.grouped(j);
+                let effect = if clustered || sticks || grouped {
                     contacts
                         .stuck_pair(i, j, &e.shift, e.time, &e.normal)
                         .map_err(stuck_error)?
@@ -665,9 +677,10 @@ where
                 (effect, Collision::BallBall { time, i, j })
             }
             Target::Border => (
-                match Clusters::of(contacts.balls, i) {
-                    Some(c) => contacts.cluster_surface(c, i, Surface::Wall, &e.normal, e.time),
-                    None => contacts.ball_surface(i, Surface::Wall, &e.normal, e.time),
+                if clustered || grouped_i {
+                    contacts.stuck_surface(i, Surface::Wall, &e.normal, e.time)
+                } else {
+                    contacts.ball_surface(i, Surface::Wall, &e.normal, e.time)
                 },
                 Collision::BallBorder { time, i },
             ),
@@ -675,17 +688,16 @@ where
                 let k = k as usize;
                 let surface = Surface::Box(k, self.boxes.vel[k]);
                 (
-                    match Clusters::of(contacts.balls, i) {
-                        Some(c) => contacts.cluster_surface(c, i, surface, &e.normal, e.time),
-                        None => contacts.ball_surface(i, surface, &e.normal, e.time),
+                    if clustered || grouped_i {
+                        contacts.stuck_surface(i, surface, &e.normal, e.time)
+                    } else {
+                        contacts.ball_surface(i, surface, &e.normal, e.time)
                     },
                     Collision::BallBox { time, i, k },
                 )
             }
         };
         self.touches = touches;
-        self.member_supports = member_supports;
-        self.changed.clear();
         for ball in [i, other] {
             match Clusters::of(&self.balls, ball) {
                 Some(c) => self
@@ -791,52 +803,6 @@ where
             }
         }
         self.candidates = candidates;
-    }
-
-    /// The free balls below the members of the clusters of balls `i` and `other` at
-    /// in-step time `s` (see [`Self::gather`]), which can hold the cluster up as a ball
-    /// below holds a ball (see `stick`). One support query per member: paid only by
-    /// contacts of clusters under gravity.
-    fn gather_member_supports(
-        &mut self,
-        i: usize,
-        other: usize,
-        s: T,
-        out: &mut Vec<MemberSupport<T, D>>,
-    ) {
-        let mut found = core::mem::take(&mut self.member_touches);
-        let clusters = [i, other].map(|k| Clusters::of(&self.balls, k));
-        for (k, c) in clusters.iter().enumerate() {
-            let Some(c) = *c else { continue };
-            if k == 1 && clusters[0] == Some(c) {
-                continue;
-            }
-            for m in 0..self.clusters.list[c].members.len() {
-                let member = self.clusters.list[c].members[m] as usize;
-                found.clear();
-                self.gather(member, s, &mut found);
-                let x = self.balls.position_at(member, s);
-                for t in &found {
-                    let Support::Ball(j) = t.support else {
-                        continue;
-                    };
-                    if Clusters::of(&self.balls, j as usize).is_some() {
-                        continue;
-                    }
-                    // `gather` met ball j at its minimum image: keep the shift to it.
-                    let y = self.balls.position_at(j as usize, s);
-                    let shift = self
-                        .periodic
-                        .map_or_else(Vector::zeros, |p| p.minimum_image(&(y - x)) - (y - x));
-                    out.push(MemberSupport {
-                        member: member as u32,
-                        ball: j,
-                        shift,
-                    });
-                }
-            }
-        }
-        self.member_touches = found;
     }
 
     /// Stops every ball and cluster at in-step time `s` for the rest of the step

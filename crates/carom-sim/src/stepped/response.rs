@@ -45,8 +45,11 @@ use nalgebra::Const;
 
 use super::balls::BallArrays;
 use super::clusters::Clusters;
+use super::lcp::Lcp;
 use super::obstacles::BoxArrays;
-use super::rest::{MemberSupport, RestSet, Support, Touch};
+use super::rest::{RestSet, Support, Touch};
+use super::stack::Groups;
+use super::sweep::Sweep;
 use crate::engine::Angular;
 use crate::scene::{Inelastic, Scene, SceneError};
 
@@ -187,6 +190,9 @@ where
     Const<D>: Space<T, D>,
 {
     pub(crate) balls: &'a mut BallArrays<T, D>,
+    /// Balls changed beyond the contact's own (and their clusters' members): a hold's
+    /// whole stack (see `stack`).
+    pub(crate) changed: &'a mut Vec<u32>,
     pub(crate) boxes: &'a BoxArrays<T, D>,
     /// The reflecting border, if any.
     pub(crate) border: Option<&'a Border<T, D>>,
@@ -195,12 +201,19 @@ where
     pub(crate) rest: &'a mut RestSets<T, D>,
     /// The stuck clusters (see `stick`).
     pub(crate) clusters: &'a mut Clusters<T, D>,
+    /// The periodic domain, if any.
+    pub(crate) periodic: Option<&'a Border<T, D>>,
+    /// The broad phase, for the neighbours of a stack's balls (see `stack`).
+    pub(crate) sweep: &'a Sweep<T, D>,
+    /// Scratch for the broad phase's candidates.
+    pub(crate) candidates: &'a mut Vec<u32>,
+    /// Scratch of a stack's complementarity problems.
+    pub(crate) lcp: &'a mut Lcp<T>,
+    /// The bodies held together in this step (see `stack`).
+    pub(crate) groups: &'a mut Groups,
     /// The supports the contact's balls touch now: `(ball, touches)` (gathered only
     /// under gravity; see `rest_on`).
     pub(crate) touching: [(usize, &'a [Touch<T, D>]); 2],
-    /// The free balls under the members of the contact's clusters (gathered only under
-    /// gravity; see `stick`).
-    pub(crate) member_supports: &'a [MemberSupport<T, D>],
     /// The step's length.
     pub(crate) h: T,
     /// The internal time of the step's start (for time-dependent fields).
@@ -222,7 +235,7 @@ where
     }
 
     /// Re-integrates ball `i` from its segment start to the end of the step.
-    fn reintegrate(&mut self, i: usize) {
+    pub(super) fn reintegrate(&mut self, i: usize) {
         let b = &mut *self.balls;
         let (mut x, mut v, mut w) = (b.seg_x[i], b.seg_v[i], b.seg_w[i]);
         let s = b.seg_t[i];

@@ -49,19 +49,6 @@ pub(crate) struct Touch<T: Real, const D: usize> {
     pub(crate) velocity: Vector<T, D>,
 }
 
-/// A free ball touching a member of a stuck cluster from below at the instant of a
-/// contact: it can hold the cluster up (see `stick`).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct MemberSupport<T: Real, const D: usize> {
-    /// The cluster's member.
-    pub(crate) member: u32,
-    /// The ball below it.
-    pub(crate) ball: u32,
-    /// The periodic shift of the ball's position to the image the member touches (zero
-    /// in open space).
-    pub(crate) shift: Vector<T, D>,
-}
-
 /// The support constraints of one ball at one instant.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct RestSet<T: Real, const D: usize> {

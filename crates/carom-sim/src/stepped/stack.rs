@@ -1,0 +1,986 @@
+//! Holding a stack: every cluster and ball in contact with a cluster's resting contact,
+//! and the walls, boxes and held balls under them, all at once.
+//!
+//! A contact of a stuck cluster whose chord still closes after its impulse (see `stick`)
+//! holds the **stack** around it, found from the contact outwards: the clusters touching
+//! a member of a cluster in the stack (or closing on one within the step), the free balls
+//! touching a member, and what touches those. A free ball touching a cluster's member from
+//! below, held in this step and not moving up into it, is no body of the stack but a
+//! surface moving at its chord (shock propagation, as for a ball on a held ball in
+//! `response`); walls and boxes are surfaces. A free ball takes part only with its walls,
+//! boxes and held balls below: its contacts with other free balls are the balls' own
+//! events. Every body of the stack restarts at the contact's instant `s` free of earlier
+//! holds of the step (see `clusters`: its physical state there, the force dropped), and
+//! the stack's contacts are solved in two phases:
+//!
+//! 1. **Impacts.** The contacts touching now whose bodies approach at `s` (no faster than
+//!    gravity adds in two steps: faster ones are collisions, left to their own events)
+//!    get restitution-0 impulses on the velocities at `s`, all at once. This stops a ball
+//!    landing slowly on a held cluster for good; without it the force below would turn
+//!    the landing speed around, and the ball would bounce on forever.
+//! 2. **The hold.** Every contact, touching or closing within the rest of the step `τ`
+//!    (speculative: a gap `g` may close at `g/τ`, no faster), gets the impulse that stops
+//!    its chords closing, all at once. These impulses are the step's **constant contact
+//!    force** `F = P/(w τ)` (`w` the integrator's chord weight,
+//!    `Integrator::chord_weight`): a body's chord changes by `P/m`, its end velocity by
+//!    `P/(w m)` (twice the chord's with Verlet, RK4 and the exact integrator, as much with
+//!    semi-implicit Euler), its velocity at `s` not at all; torques alike. So a ball
+//!    resting on a cluster passes its whole load's torque to the end of the step, and
+//!    what the ball and the cluster end the step with is what the force gave them: no
+//!    correction of the end velocities afterwards. Explicit Euler's chords are the start
+//!    velocities, which no force within the step moves (`w = 0`): its holds are impulses
+//!    at `s`, like the impacts.
+//!
+//! **Exact impulses.** Each phase solves the contacts' linear complementarity problem
+//! exactly (`lcp`: the impulses are non-negative, push only where a contact would close
+//! beyond its margin, and leave none closing), whatever the mass ratios: a cluster a
+//! million times heavier than the one it rests on is held in one solve. With friction the
+//! normal impulses and the tangential ones (Coulomb's cone, projected Gauss–Seidel) are
+//! solved in turn until they agree (staggered projections).
+//!
+//! **Rotations.** A cluster's chords follow its rotation over the rest of the step, which
+//! the problem sees to first order (`Δu = ΔV + ΔΩ × a`). What the first order leaves
+//! closing (second order in the rotation the force adds) is added to the margins and the
+//! hold solved again from the free state, until nothing closes beyond a fraction of the
+//! resting floor; what it leaves opening is kept, so the first step of a tipping body
+//! has its first instant's angular acceleration exactly.
+//!
+//! **Energy.** With the integrators exact for constant gravity (Verlet, RK4, exact), the
+//! hold changes the energy at the step's end by `ΔE = 2 Σ P·u'` summed over the bodies
+//! (`u'` the held chords, `P` the impulses), which is `−2 Σ λ g/τ <= 0` over the
+//! contacts (a contact pushes only where its chords close exactly at its margin): the
+//! hold never adds energy, to first order in the rotation. The impacts are inelastic
+//! impulses at `s`, which only take energy.
+
+use carom_integrate::ForceField;
+use carom_math::{Real, Space, Vector};
+use nalgebra::Const;
+
+use carom_response::RigidCluster;
+
+use super::clusters::{FREE, Motion};
+use super::response::Contacts;
+use super::stick::Side;
+use super::sweep::path_box;
+use crate::engine::Angular;
+
+type Inertia<T, const D: usize> = <Const<D> as Space<T, D>>::Inertia;
+
+/// Rounds of the hold against the rotation's second order (see the module
+/// documentation): each removes what the one before left closing, which is of the order
+/// of its square.
+const HOLD_ROUNDS: usize = 8;
+
+/// Rounds of normal and tangential impulses in turn, with friction.
+const FRICTION_ROUNDS: usize = 32;
+
+/// A body of a stack: a free ball or a cluster, restarted at the hold's instant.
+struct Part<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    side: Side,
+    inverse_mass: T,
+    inverse_inertia: Inertia<T, D>,
+    /// The centre of mass at the hold's instant.
+    centre: Vector<T, D>,
+    /// The state before the hold's force, which each round applies it to.
+    free: Free<T, D>,
+}
+
+/// A body's state before the hold's force (see [`Contacts::save_free`]).
+#[derive(Clone, Copy, Debug)]
+enum Free<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Not saved yet.
+    Unsaved,
+    /// A free ball's segment: velocity at its start, chord, end velocity, start and end
+    /// spins.
+    Ball([Vector<T, D>; 3], [Angular<T, D>; 2]),
+    /// A cluster's rigid state at its segment start.
+    Cluster(RigidCluster<T, D>),
+}
+
+/// One end of a contact on a body of the stack.
+#[derive(Clone, Copy, Debug)]
+struct End<T: Real, const D: usize> {
+    /// The body.
+    part: usize,
+    /// Its ball that touches.
+    ball: usize,
+    /// From the body's centre of mass to the contact point.
+    arm: Vector<T, D>,
+    /// From the ball's centre to the contact point.
+    lever: Vector<T, D>,
+}
+
+/// What the other end of a contact is.
+#[derive(Clone, Copy, Debug)]
+enum Other<T: Real, const D: usize> {
+    /// A wall or a box, moving at this velocity.
+    Surface(Vector<T, D>),
+    /// A held free ball below, moving at its chord (shock propagation).
+    Held(usize),
+    /// A body of the stack.
+    Part(End<T, D>),
+}
+
+/// A contact of the stack: `end` touches `other` along the unit `normal` (from the ball
+/// into the other) across `gap`.
+#[derive(Clone, Copy, Debug)]
+struct Row<T: Real, const D: usize> {
+    end: End<T, D>,
+    other: Other<T, D>,
+    normal: Vector<T, D>,
+    gap: T,
+}
+
+/// The bodies and contacts of a stack.
+struct Stack<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    /// The hold's instant (in-step time).
+    s: T,
+    parts: Vec<Part<T, D>>,
+    rows: Vec<Row<T, D>>,
+}
+
+impl<T: Real, const D: usize> Stack<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    fn find(&self, side: Side) -> Option<usize> {
+        self.parts.iter().position(|p| p.side == side)
+    }
+
+    /// The ends of row `c` with their signs: `+1` for the end a push moves along `−n`.
+    fn ends(&self, c: usize) -> impl Iterator<Item = (End<T, D>, T)> + '_ {
+        let row = &self.rows[c];
+        let other = match row.other {
+            Other::Part(e) => Some((e, -T::one())),
+            Other::Surface(_) | Other::Held(_) => None,
+        };
+        core::iter::once((row.end, T::one())).chain(other)
+    }
+}
+
+/// The bodies held together in the current step: those a hold's force connects (its
+/// contacts between two bodies that push). A body's force is half of an interaction, so
+/// whenever one of them restarts (a collision, another hold) the whole group is held
+/// again: otherwise one side would keep the force the other lost, and momentum would
+/// not be kept.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Groups {
+    /// Per ball: its group, or [`NONE`].
+    of: Vec<u32>,
+    /// Per group: its balls (a cluster's members all).
+    balls: Vec<Vec<u32>>,
+}
+
+/// A ball in no group.
+const NONE: u32 = u32::MAX;
+
+impl Groups {
+    /// No groups, for `n` balls.
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            of: vec![NONE; n],
+            balls: Vec::new(),
+        }
+    }
+
+    /// Forgets every group (at the start of a step).
+    pub(crate) fn clear(&mut self) {
+        for group in &self.balls {
+            for &b in group {
+                self.of[b as usize] = NONE;
+            }
+        }
+        self.balls.clear();
+    }
+
+    /// Whether ball `i` is held with other bodies in this step.
+    pub(crate) fn grouped(&self, i: usize) -> bool {
+        self.of[i] != NONE
+    }
+}
+
+/// The contact a hold is for: ball `ball` touching `other`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Seed<T: Real, const D: usize> {
+    pub(crate) ball: usize,
+    pub(crate) other: SeedOther<T, D>,
+}
+
+/// What the ball of a [`Seed`] touches.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum SeedOther<T: Real, const D: usize> {
+    /// Another ball.
+    Ball(usize),
+    /// A wall or a box, along this unit normal from the ball into it.
+    Surface(Vector<T, D>),
+}
+
+impl<T: Real, const D: usize> Seed<T, D> {
+    /// Whether `row` is this contact (either way round).
+    fn is(&self, row: &Row<T, D>) -> bool {
+        match (self.other, row.other) {
+            (SeedOther::Ball(j), Other::Part(e)) => {
+                (row.end.ball, e.ball) == (self.ball, j) || (row.end.ball, e.ball) == (j, self.ball)
+            }
+            (SeedOther::Ball(j), Other::Held(k)) => {
+                (row.end.ball, k) == (self.ball, j) || (row.end.ball, k) == (j, self.ball)
+            }
+            (SeedOther::Surface(n), Other::Surface(_)) => {
+                row.end.ball == self.ball && (row.normal - n).norm() <= T::lit(1e-9)
+            }
+            _ => false,
+        }
+    }
+}
+
+/// Which velocities a phase acts on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    /// The physical velocities at the hold's instant.
+    Start,
+    /// The chords.
+    Chord,
+}
+
+/// The velocity changes of the bodies of a stack under a set of impulses.
+struct Changes<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Per body: linear impulse and angular impulse about its centre.
+    impulse: Vec<(Vector<T, D>, Angular<T, D>)>,
+}
+
+impl<T: Real, const D: usize> Changes<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    fn new(parts: usize) -> Self {
+        Self {
+            impulse: vec![(Vector::zeros(), <Const<D> as Space<T, D>>::angular_zero()); parts],
+        }
+    }
+
+    /// Adds the impulse `p` at end `e` (sign `sign`: `p` acts on the row's ball, `−p` on
+    /// the other end).
+    fn add(&mut self, e: &End<T, D>, sign: T, p: &Vector<T, D>) {
+        let p = p * sign;
+        let (linear, angular) = &mut self.impulse[e.part];
+        *linear += p;
+        *angular += <Const<D> as Space<T, D>>::cross(&e.arm, &p);
+    }
+
+    /// The velocity change of the point at end `e`.
+    fn at(&self, stack: &Stack<T, D>, e: &End<T, D>) -> Vector<T, D> {
+        let part = &stack.parts[e.part];
+        let (linear, angular) = &self.impulse[e.part];
+        let dw = <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
+        linear * part.inverse_mass + <Const<D> as Space<T, D>>::angular_cross(&dw, &e.arm)
+    }
+}
+
+/// The inverse effective mass of end `e` of body `part` along the unit `d`.
+fn stiffness<T: Real, const D: usize>(part: &Part<T, D>, e: &End<T, D>, d: &Vector<T, D>) -> T
+where
+    Const<D>: Space<T, D>,
+{
+    let ad = <Const<D> as Space<T, D>>::cross(&e.arm, d);
+    part.inverse_mass
+        + <Const<D> as Space<T, D>>::angular_dot(
+            &ad,
+            &<Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, &ad),
+        )
+}
+
+impl<T: Real, const D: usize, F: ForceField<T, D>> Contacts<'_, T, D, F>
+where
+    Const<D>: Space<T, D>,
+{
+    /// Holds the stack around the contact `seed` at in-step time `s` (see the module
+    /// documentation).
+    pub(crate) fn hold_stack(&mut self, seed: Seed<T, D>, s: T) {
+        let mut stack = Stack {
+            s,
+            parts: Vec::new(),
+            rows: Vec::new(),
+        };
+        // The contact's bodies; a free ball held below a cluster's member it touches is
+        // that member's support (see `rows_of`), not a body of the stack.
+        let (i, j) = match seed.other {
+            SeedOther::Ball(j) => (seed.ball, j),
+            SeedOther::Surface(_) => (seed.ball, seed.ball),
+        };
+        for (ball, other) in [(i, j), (j, i)] {
+            let free = self.balls.cluster[ball] == FREE;
+            if !(free && self.balls.cluster[other] != FREE && self.holds_up(other, ball, s)) {
+                self.enter(&mut stack, self.side(ball), s);
+            }
+        }
+        let mut k = 0;
+        while k < stack.parts.len() {
+            let balls: Vec<usize> = match stack.parts[k].side {
+                Side::Ball(i) => vec![i],
+                Side::Cluster(c) => (self.clusters.list[c].members.iter())
+                    .map(|&m| m as usize)
+                    .collect(),
+            };
+            for x in balls {
+                self.rows_of(&mut stack, k, x, s);
+            }
+            k += 1;
+        }
+        if stack.rows.is_empty() {
+            return;
+        }
+        let b = &*self.balls;
+        // Touching: within rounding of the ball's size, or of what an approach at the
+        // resting floor closes in the rest of the step (the narrow phase tells neither
+        // from a contact).
+        let reach = self.rules.floor * (self.h - s);
+        let tolerance = |c: usize| {
+            let row = &stack.rows[c];
+            let r = b.radius[row.end.ball];
+            T::lit(1e-9) * r
+                + T::lit(16.0) * T::EPSILON * (b.seg_x[row.end.ball].amax() + r)
+                + reach
+        };
+        let start: Vec<_> = (0..stack.rows.len())
+            .map(|c| self.relative(&stack, c, Phase::Start))
+            .collect();
+        // A contact approaching faster than support is a collision, its own event: left
+        // out, unless it is the contact the hold is for (whose collision has been
+        // answered: what it left closing, a cluster turning into a floor it struck, is
+        // stopped here).
+        let fast: Vec<bool> = (stack.rows.iter().zip(&start))
+            .map(|(row, u)| u.dot(&row.normal) > self.rules.support_speed && !seed.is(row))
+            .collect();
+        // 1. Impacts: restitution 0 on the velocities at s, touching contacts only.
+        let touching: Vec<usize> = (0..stack.rows.len())
+            .filter(|&c| !fast[c] && stack.rows[c].gap <= tolerance(c))
+            .collect();
+        let zero = vec![T::zero(); touching.len()];
+        let impacts = self.impulses(&stack, &touching, &start, &zero);
+        let mut pushed = vec![false; stack.rows.len()];
+        if impacts.iter().any(|p| *p != Vector::<T, D>::zeros()) {
+            let changes = Self::changes(&stack, &touching, &impacts, &mut pushed);
+            self.strike(&stack, &changes);
+        }
+        // 2. The hold: the chords, as a constant force over the rest of the step.
+        let held: Vec<usize> = (0..stack.rows.len()).filter(|&c| !fast[c]).collect();
+        self.save_free(&mut stack);
+        let mut forced = vec![false; stack.rows.len()];
+        self.hold(&stack, &held, s, &mut forced);
+        for (p, f) in pushed.iter_mut().zip(&forced) {
+            *p |= *f;
+        }
+        self.mark_held(&stack, &pushed);
+        self.regroup(&stack, &forced);
+    }
+
+    /// Phase 2 of [`Self::hold_stack`] on the rows `held`, rounds against the rotation's
+    /// second order included; marks the rows that push in `pushed`.
+    ///
+    /// The first round is the first-order hold. Each next one takes the chords the force
+    /// of the last one left, removes that force from them to first order (what the
+    /// chords would be without it, seen from where the bodies turn to now) and solves the
+    /// whole problem again from there: Newton's method on the contacts' complementarity
+    /// conditions, so that a contact the last round pushed too hard gets less (a rocking
+    /// cluster on three members) and one it left closing more.
+    fn hold(&mut self, stack: &Stack<T, D>, held: &[usize], s: T, pushed: &mut [bool]) {
+        let rest = self.h - s;
+        let targets: Vec<T> = held.iter().map(|&c| stack.rows[c].gap / rest).collect();
+        let done = self.rules.floor * T::lit(0.25);
+        let mut total = vec![Vector::<T, D>::zeros(); held.len()];
+        let mut unused = vec![false; stack.rows.len()];
+        for _ in 0..HOLD_ROUNDS {
+            let mut chords: Vec<_> = (0..stack.rows.len())
+                .map(|c| self.relative(stack, c, Phase::Chord))
+                .collect();
+            let left = (held.iter().zip(&targets))
+                .map(|(&c, &t)| chords[c].dot(&stack.rows[c].normal) - t)
+                .fold(T::zero(), T::max);
+            if left <= done {
+                break;
+            }
+            let force = Self::changes(stack, held, &total, &mut unused);
+            for &c in held {
+                let moved = (stack.ends(c)).fold(Vector::zeros(), |sum, (e, sign)| {
+                    sum + force.at(stack, &e) * sign
+                });
+                chords[c] -= moved;
+            }
+            total = self.impulses(stack, held, &chords, &targets);
+            let changes = Self::changes(stack, held, &total, &mut unused);
+            self.push(stack, &changes);
+        }
+        Self::changes(stack, held, &total, pushed);
+    }
+
+    /// Enters `side` into the stack (once), restarted at `s` free of the step's earlier
+    /// holds; returns its index.
+    fn enter(&mut self, stack: &mut Stack<T, D>, side: Side, s: T) -> usize {
+        if let Some(k) = stack.find(side) {
+            return k;
+        }
+        let part = match side {
+            Side::Ball(i) => {
+                self.balls.restart(i, s, self.h);
+                self.reintegrate(i);
+                self.balls.supported[i] = false;
+                self.rest.restart(i, s, self.balls.chord[i]);
+                let b = &*self.balls;
+                Part {
+                    side,
+                    inverse_mass: b.inverse_mass[i],
+                    inverse_inertia: <Const<D> as Space<T, D>>::inertia_isotropic(
+                        b.inverse_inertia[i],
+                    ),
+                    centre: b.seg_x[i],
+                    free: Free::Unsaved,
+                }
+            }
+            Side::Cluster(c) => {
+                let rigid = self.begin_cluster(c, s);
+                self.finish_cluster(c, rigid);
+                Part {
+                    side,
+                    inverse_mass: T::one() / rigid.mass(),
+                    inverse_inertia: rigid.world_inverse_inertia(),
+                    centre: rigid.center(),
+                    free: Free::Unsaved,
+                }
+            }
+        };
+        let balls = match side {
+            Side::Ball(i) => vec![i as u32],
+            Side::Cluster(c) => self.clusters.list[c].members.clone(),
+        };
+        self.changed.extend_from_slice(&balls);
+        stack.parts.push(part);
+        let k = stack.parts.len() - 1;
+        // The bodies held with it in this step are held again with it (a cluster fused
+        // in this step may hold the groups of both its parts).
+        for b in balls {
+            let group = self.groups.of[b as usize];
+            if group == NONE {
+                continue;
+            }
+            let others = core::mem::take(&mut self.groups.balls[group as usize]);
+            for &o in &others {
+                let side = self.side(o as usize);
+                self.enter(stack, side, s);
+            }
+            self.groups.balls[group as usize] = others;
+        }
+        k
+    }
+
+    /// Groups the bodies of `stack` that the hold's force connects (rows between two
+    /// bodies that push, `pushed`), after forgetting their earlier groups (all of which
+    /// the stack holds).
+    fn regroup(&mut self, stack: &Stack<T, D>, pushed: &[bool]) {
+        let balls_of = |this: &Self, side: Side| -> Vec<u32> {
+            match side {
+                Side::Ball(i) => vec![i as u32],
+                Side::Cluster(c) => this.clusters.list[c].members.clone(),
+            }
+        };
+        for part in &stack.parts {
+            for b in balls_of(self, part.side) {
+                self.groups.of[b as usize] = NONE;
+            }
+        }
+        // Components by repeated relabelling (stacks are small).
+        let mut label: Vec<usize> = (0..stack.parts.len()).collect();
+        let mut changed = true;
+        while changed {
+            changed = false;
+            for (row, _) in stack.rows.iter().zip(pushed).filter(|(_, p)| **p) {
+                if let Other::Part(e) = row.other {
+                    let low = label[row.end.part].min(label[e.part]);
+                    for k in [row.end.part, e.part] {
+                        if label[k] != low {
+                            label[k] = low;
+                            changed = true;
+                        }
+                    }
+                }
+            }
+        }
+        for root in 0..stack.parts.len() {
+            let members: Vec<usize> = (0..stack.parts.len())
+                .filter(|&k| label[k] == root)
+                .collect();
+            if members.len() < 2 {
+                continue;
+            }
+            let id = self.groups.balls.len() as u32;
+            let mut balls = Vec::new();
+            for k in members {
+                for b in balls_of(self, stack.parts[k].side) {
+                    self.groups.of[b as usize] = id;
+                    balls.push(b);
+                }
+            }
+            self.groups.balls.push(balls);
+        }
+    }
+
+    /// The walls and boxes ball `x` could touch at `s`: `(unit normal from the ball into
+    /// the surface, surface velocity, gap)` for every wall of the border and the nearest
+    /// point of every box (at its periodic image nearest the ball).
+    pub(super) fn surfaces_of(&self, x: usize, s: T) -> Vec<(Vector<T, D>, Vector<T, D>, T)> {
+        let b = &*self.balls;
+        let (p, r) = (b.position_at(x, s), b.radius[x]);
+        let mut out = Vec::new();
+        if let Some(border) = self.border {
+            for axis in 0..D {
+                for (upper, gap) in [
+                    (false, p[axis] - r - border.min()[axis]),
+                    (true, border.max()[axis] - p[axis] - r),
+                ] {
+                    let mut n = Vector::zeros();
+                    n[axis] = if upper { T::one() } else { -T::one() };
+                    out.push((n, Vector::zeros(), gap));
+                }
+            }
+        }
+        for k in 0..self.boxes.len() {
+            let obb = self.boxes.at(k, s);
+            let shift = self.periodic.map_or_else(Vector::zeros, |border| {
+                border.minimum_image(&(obb.center() - p)) - (obb.center() - p)
+            });
+            let local = obb.to_local(&(p - shift));
+            let half = obb.half_extents();
+            let q = obb.to_world(&local.inf(&half).sup(&-half)) + shift;
+            let d = (q - p).norm();
+            if d > T::zero() {
+                out.push(((q - p) / d, self.boxes.vel[k], d - r));
+            }
+        }
+        out
+    }
+
+    /// Adds the contacts of ball `x` of body `k` of the stack at `s` that touch or close
+    /// within the rest of the step: its walls and boxes, the held free balls below it,
+    /// and the bodies it touches (entered into the stack if new; a contact between two
+    /// bodies is added once, from the first).
+    fn rows_of(&mut self, stack: &mut Stack<T, D>, k: usize, x: usize, s: T) {
+        let rest = self.h - s;
+        let (p, r, chord) = {
+            let b = &*self.balls;
+            (b.position_at(x, s), b.radius[x], b.chord[x])
+        };
+        let tolerance = T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (p.amax() + r);
+        let near = |gap: T, closing: T| gap <= tolerance || closing * rest > gap;
+        let centre = stack.parts[k].centre;
+        let end = |n: &Vector<T, D>| End {
+            part: k,
+            ball: x,
+            arm: p + n * r - centre,
+            lever: n * r,
+        };
+        for (n, v, gap) in self.surfaces_of(x, s) {
+            if near(gap, (chord - v).dot(&n)) {
+                stack.rows.push(Row {
+                    end: end(&n),
+                    other: Other::Surface(v),
+                    normal: n,
+                    gap: gap.max(T::zero()),
+                });
+            }
+        }
+        let mut candidates = core::mem::take(self.candidates);
+        let path = path_box(&p, &self.balls.pos[x], r + tolerance);
+        self.sweep.candidates(x, &path, &mut candidates);
+        candidates.sort_unstable();
+        candidates.dedup();
+        let n_balls = self.balls.len();
+        let cluster_body = matches!(stack.parts[k].side, Side::Cluster(_));
+        for &j in &candidates {
+            let j = j as usize;
+            if j >= n_balls || j == x || self.side(j) == self.side(x) {
+                continue;
+            }
+            let b = &*self.balls;
+            let y = b.position_at(j, s);
+            let y = self
+                .periodic
+                .map_or(y, |border| p + border.minimum_image(&(y - p)));
+            let d = (y - p).norm();
+            if d <= T::zero() {
+                continue;
+            }
+            let n = (y - p) / d;
+            let gap = d - r - b.radius[j];
+            if !near(gap, (chord - b.chord[j]).dot(&n)) {
+                continue;
+            }
+            let side = self.side(j);
+            let other = match (stack.find(side), side) {
+                (Some(o), _) if o <= k => continue,
+                (Some(o), _) => o,
+                (None, Side::Ball(_)) if self.holds_up(x, j, s) => {
+                    stack.rows.push(Row {
+                        end: end(&n),
+                        other: Other::Held(j),
+                        normal: n,
+                        gap: gap.max(T::zero()),
+                    });
+                    continue;
+                }
+                (None, Side::Ball(_)) if !cluster_body => continue,
+                (None, _) => self.enter(stack, side, s),
+            };
+            // The contact point, on ball x's surface; ball j's position moved to x's image.
+            let point = p + n * r;
+            let shift = y - self.balls.position_at(j, s);
+            stack.rows.push(Row {
+                end: end(&n),
+                other: Other::Part(End {
+                    part: other,
+                    ball: j,
+                    arm: point - (stack.parts[other].centre + shift),
+                    lever: point - y,
+                }),
+                normal: n,
+                gap: gap.max(T::zero()),
+            });
+        }
+        *self.candidates = candidates;
+    }
+
+    /// Whether free ball `j` holds ball `x` up at `s` as an immovable surface moving at its
+    /// chord: it lies below `x` along gravity, is held in this step and does not move up
+    /// into it (shock propagation).
+    fn holds_up(&self, x: usize, j: usize, s: T) -> bool {
+        let b = &*self.balls;
+        let (p, y) = (b.position_at(x, s), b.position_at(j, s));
+        let y = self
+            .periodic
+            .map_or(y, |border| p + border.minimum_image(&(y - p)));
+        let n = y - p;
+        x != j
+            && self.rules.gravity.dot(&n) > T::zero()
+            && b.supported[j]
+            && b.chord[j].dot(&n) >= -self.rules.floor * n.norm()
+    }
+
+    /// The velocity of the contact point at end `e` in `phase`.
+    fn end_velocity(&self, stack: &Stack<T, D>, e: &End<T, D>, phase: Phase) -> Vector<T, D> {
+        let b = &*self.balls;
+        match stack.parts[e.part].side {
+            Side::Ball(i) => {
+                let v = match phase {
+                    Phase::Start => b.seg_v[i],
+                    Phase::Chord => b.chord[i],
+                };
+                v + <Const<D> as Space<T, D>>::angular_cross(&b.seg_w[i], &e.lever)
+            }
+            Side::Cluster(c) => {
+                let cluster = &self.clusters.list[c];
+                match phase {
+                    Phase::Start => {
+                        let r = &cluster.start;
+                        r.velocity()
+                            + <Const<D> as Space<T, D>>::angular_cross(
+                                &r.angular_velocity(),
+                                &e.arm,
+                            )
+                    }
+                    Phase::Chord => {
+                        let w = cluster.drive().angular_velocity();
+                        b.chord[e.ball] + <Const<D> as Space<T, D>>::angular_cross(&w, &e.lever)
+                    }
+                }
+            }
+        }
+    }
+
+    /// The velocity of row `c`'s ball's contact point relative to the other end, in
+    /// `phase` (its normal component is the approach speed).
+    fn relative(&self, stack: &Stack<T, D>, c: usize, phase: Phase) -> Vector<T, D> {
+        let row = &stack.rows[c];
+        let other = match row.other {
+            Other::Surface(v) => v,
+            Other::Held(j) => match phase {
+                Phase::Start => self.balls.velocity_at(j, stack.s, self.h).0,
+                Phase::Chord => self.balls.chord[j],
+            },
+            Other::Part(e) => self.end_velocity(stack, &e, phase),
+        };
+        self.end_velocity(stack, &row.end, phase) - other
+    }
+
+    /// The impulses on the ball ends of `rows` (the other ends take the opposite) that
+    /// stop each closing faster than its `margins` entry, from the relative velocities
+    /// `relative` (indexed by row): normal impulses exactly (`lcp`), with friction the
+    /// tangential ones within Coulomb's cone in turn.
+    fn impulses(
+        &mut self,
+        stack: &Stack<T, D>,
+        rows: &[usize],
+        relative: &[Vector<T, D>],
+        margins: &[T],
+    ) -> Vec<Vector<T, D>> {
+        let n = rows.len();
+        if n == 0 {
+            return Vec::new();
+        }
+        // The Delassus matrix: A_cd = Σ over shared bodies σ_c σ_d (n_c·n_d/m
+        // + (a_c × n_c)·I⁻¹(a_d × n_d)), how a unit push at d changes the approach at c.
+        let mut a = vec![T::zero(); n * n];
+        for (r, &c) in rows.iter().enumerate() {
+            for (q, &d) in rows.iter().enumerate().skip(r) {
+                let (nc, nd) = (&stack.rows[c].normal, &stack.rows[d].normal);
+                let mut sum = T::zero();
+                for (ec, sc) in stack.ends(c) {
+                    for (ed, sd) in stack.ends(d).filter(|(e, _)| e.part == ec.part) {
+                        let part = &stack.parts[ec.part];
+                        let ac = <Const<D> as Space<T, D>>::cross(&ec.arm, nc);
+                        let ad = <Const<D> as Space<T, D>>::cross(&ed.arm, nd);
+                        let angular = <Const<D> as Space<T, D>>::angular_dot(
+                            &ac,
+                            &<Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, &ad),
+                        );
+                        sum += sc * sd * (nc.dot(nd) * part.inverse_mass + angular);
+                    }
+                }
+                a[r * n + q] = sum;
+                a[q * n + r] = sum;
+            }
+        }
+        let approach: Vec<T> = (rows.iter())
+            .map(|&c| relative[c].dot(&stack.rows[c].normal))
+            .collect();
+        let tolerance = self.rules.floor * T::lit(1e-3);
+        let mut lambda = vec![T::zero(); n];
+        let mut tangential = vec![Vector::<T, D>::zeros(); n];
+        let friction = self.rules.friction;
+        for _ in 0..FRICTION_ROUNDS {
+            // Normal impulses against the approach the tangential ones leave.
+            let mut changes = Changes::new(stack.parts.len());
+            for (k, &c) in rows.iter().enumerate() {
+                for (e, sign) in stack.ends(c) {
+                    changes.add(&e, sign, &tangential[k]);
+                }
+            }
+            let q: Vec<T> = (rows.iter().enumerate())
+                .map(|(k, &c)| {
+                    let row = &stack.rows[c];
+                    let moved = stack.ends(c).fold(Vector::zeros(), |sum, (e, sign)| {
+                        sum + changes.at(stack, &e) * sign
+                    });
+                    margins[k] - approach[k] - moved.dot(&row.normal)
+                })
+                .collect();
+            self.lcp.solve(&a, &q, tolerance, &mut lambda);
+            if friction <= T::zero() {
+                break;
+            }
+            // Friction, one Gauss–Seidel sweep: the accumulated tangential impulse stops
+            // the slip, within |F_t| <= μ λ.
+            let mut change = T::zero();
+            let mut scale = T::zero();
+            let mut changes = Changes::new(stack.parts.len());
+            for (l, &d) in rows.iter().enumerate() {
+                let p = tangential[l] - stack.rows[d].normal * lambda[l];
+                for (e, sign) in stack.ends(d) {
+                    changes.add(&e, sign, &p);
+                }
+            }
+            for (k, &c) in rows.iter().enumerate() {
+                let row = &stack.rows[c];
+                let moved = stack.ends(c).fold(Vector::zeros(), |sum, (e, sign)| {
+                    sum + changes.at(stack, &e) * sign
+                });
+                let u = relative[c] + moved;
+                let slip = u - row.normal * u.dot(&row.normal);
+                let speed = slip.norm();
+                scale = scale.max(relative[c].norm());
+                if speed <= T::zero() {
+                    continue;
+                }
+                let t = slip / speed;
+                let k_t = stack.ends(c).fold(T::zero(), |sum, (e, _)| {
+                    sum + stiffness(&stack.parts[e.part], &e, &t)
+                });
+                let wanted = tangential[k] - t * (speed / k_t);
+                let bound = friction * lambda[k];
+                let clamped = if wanted.norm() > bound {
+                    wanted * (bound / wanted.norm())
+                } else {
+                    wanted
+                };
+                let step = clamped - tangential[k];
+                tangential[k] = clamped;
+                for (e, sign) in stack.ends(c) {
+                    changes.add(&e, sign, &step);
+                }
+                change = change.max(step.norm() * k_t);
+            }
+            if change <= T::lit(1e-12) * scale {
+                break;
+            }
+        }
+        (rows.iter().zip(lambda.iter().zip(&tangential)))
+            .map(|(&c, (&l, t))| t - stack.rows[c].normal * l)
+            .collect()
+    }
+
+    /// The bodies' impulses of `impulses` on `rows`; marks the rows that push.
+    fn changes(
+        stack: &Stack<T, D>,
+        rows: &[usize],
+        impulses: &[Vector<T, D>],
+        pushed: &mut [bool],
+    ) -> Changes<T, D> {
+        let mut changes = Changes::new(stack.parts.len());
+        for (&c, p) in rows.iter().zip(impulses) {
+            for (e, sign) in stack.ends(c) {
+                changes.add(&e, sign, p);
+            }
+            if p.dot(&stack.rows[c].normal) < T::zero() {
+                pushed[c] = true;
+            }
+        }
+        changes
+    }
+
+    /// Applies `changes` as impulses at the bodies' segment starts (the hold's instant):
+    /// velocities, chords and ends alike.
+    fn strike(&mut self, stack: &Stack<T, D>, changes: &Changes<T, D>) {
+        for (part, (linear, angular)) in stack.parts.iter().zip(&changes.impulse) {
+            match part.side {
+                Side::Ball(i) => {
+                    let dw =
+                        <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
+                    self.balls
+                        .nudge(i, self.h, &(linear * part.inverse_mass), &dw);
+                    self.rest
+                        .restart(i, self.balls.seg_t[i], self.balls.chord[i]);
+                }
+                Side::Cluster(c) => {
+                    let rigid = Motion {
+                        velocity: linear * part.inverse_mass,
+                        momentum: *angular,
+                    }
+                    .added(&self.clusters.list[c].start, T::one());
+                    self.finish_cluster(c, rigid);
+                }
+            }
+        }
+    }
+
+    /// Keeps each body's state before the hold's force.
+    fn save_free(&self, stack: &mut Stack<T, D>) {
+        let b = &*self.balls;
+        for part in &mut stack.parts {
+            part.free = match part.side {
+                Side::Ball(i) => {
+                    Free::Ball([b.seg_v[i], b.chord[i], b.vel[i]], [b.seg_w[i], b.spin[i]])
+                }
+                Side::Cluster(c) => Free::Cluster(self.clusters.list[c].start),
+            };
+        }
+    }
+
+    /// Applies `changes` as the constant force of the rest of the step (see the module
+    /// documentation), to the state before the hold: chords by `P/m`, end velocities by
+    /// `P/(w m)`, the velocities at the segment start unchanged; spins as impulses. With
+    /// explicit Euler (`w = 0`) no force within the step moves a chord: impulses at the
+    /// segment start.
+    fn push(&mut self, stack: &Stack<T, D>, changes: &Changes<T, D>) {
+        let w = self.clusters.chord_weight;
+        let drag = self.clusters.drag;
+        let (start_share, end_share) = if w > T::zero() {
+            (T::zero(), T::one() / w)
+        } else {
+            (T::one(), T::one())
+        };
+        for (part, (linear, angular)) in stack.parts.iter().zip(&changes.impulse) {
+            let dv = linear * part.inverse_mass;
+            match (part.side, part.free) {
+                (Side::Ball(i), Free::Ball([seg_v, chord, vel], [seg_w, spin])) => {
+                    let dw =
+                        <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
+                    self.balls.set_segment(
+                        i,
+                        self.h,
+                        [seg_v + dv * start_share, chord + dv, vel + dv * end_share],
+                        [seg_w + dw, spin + dw],
+                    );
+                    self.rest
+                        .restart(i, self.balls.seg_t[i], self.balls.chord[i]);
+                }
+                (Side::Cluster(c), Free::Cluster(start)) => {
+                    let push = Motion {
+                        velocity: dv,
+                        momentum: *angular,
+                    };
+                    if w > T::zero() {
+                        self.clusters.list[c].hold(
+                            self.balls,
+                            push,
+                            self.h,
+                            self.stepper,
+                            drag,
+                            self.t0,
+                            w,
+                        );
+                    } else {
+                        self.finish_cluster(c, push.added(&start, T::one()));
+                    }
+                }
+                _ => debug_assert!(false, "a stack body without its free state"),
+            }
+        }
+    }
+
+    /// Marks the bodies held: those that reach a wall, a box or a held ball through
+    /// contacts that push (`pushed`); their balls count as held (see `onto_held`).
+    fn mark_held(&mut self, stack: &Stack<T, D>, pushed: &[bool]) {
+        let mut held = vec![false; stack.parts.len()];
+        let mut changed = true;
+        while changed {
+            changed = false;
+            for (row, _) in stack.rows.iter().zip(pushed).filter(|(_, p)| **p) {
+                let a = row.end.part;
+                let reached = match row.other {
+                    Other::Surface(_) | Other::Held(_) => true,
+                    Other::Part(e) => held[e.part],
+                };
+                if reached && !held[a] {
+                    held[a] = true;
+                    changed = true;
+                }
+                if let Other::Part(e) = row.other
+                    && held[a]
+                    && !held[e.part]
+                {
+                    held[e.part] = true;
+                    changed = true;
+                }
+            }
+        }
+        for (part, &h) in stack.parts.iter().zip(&held) {
+            match part.side {
+                Side::Ball(i) => self.balls.supported[i] = h,
+                Side::Cluster(c) => {
+                    for &m in &self.clusters.list[c].members {
+                        self.balls.supported[m as usize] = h;
+                    }
+                }
+            }
+        }
+    }
+}
