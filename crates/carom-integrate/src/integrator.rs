@@ -19,6 +19,20 @@
 //!   `|R(iy)|² = 1 − y⁶/72 + y⁸/576`, which is `≤ 1` exactly when `y ≤ 2√2`. Stable for
 //!   `ωh ≤ 2√2` (with a slight energy loss below the limit).
 //! * **Exact** has no truncation error and no step limit.
+//!
+//! ## Stability on linear drag `v̇ = −k v`
+//!
+//! With `z = −k h`, one step multiplies `v` by a polynomial `P(z)`; the scheme is stable
+//! while `|P(z)| <= 1`, beyond which a light ball under drag speeds up step after step
+//! instead of slowing down (a ball of 1 mg under `drag = 0.2` has `k = 2·10⁵ /s`):
+//!
+//! * **Explicit and semi-implicit Euler** `v' = v − h k v`: `P = 1 + z`, stable for
+//!   `k h <= 2` (the position update does not feed back into the velocity).
+//! * **Velocity Verlet** (the velocity from the rates at both ends, the end one at the
+//!   predicted `v + h a`): `P = 1 + z + z²/2`, also stable for `k h <= 2`.
+//! * **RK4**: `P = R(z)` above, stable for `k h <= 2.7852935634…`, where `R(z)`
+//!   (positive on the whole real axis) comes back to 1.
+//! * **Exact** follows `e^{−k h}`: no limit.
 
 use core::fmt;
 use core::str::FromStr;
@@ -125,6 +139,21 @@ impl Integrator {
     }
 }
 
+impl Integrator {
+    /// The largest `k h` at which linear drag `v̇ = −k v` still decays (see the
+    /// [module documentation](self)): `2` for the Euler schemes and Verlet, the real root
+    /// of `R(z) = 1` for RK4 (2.785…), infinity for the exact integrator.
+    pub fn decay_stability_limit(self) -> f64 {
+        match self {
+            Integrator::ExplicitEuler
+            | Integrator::SemiImplicitEuler
+            | Integrator::VelocityVerlet => 2.0,
+            Integrator::Rk4 => 2.785_293_563_405_282,
+            Integrator::Exact => f64::INFINITY,
+        }
+    }
+}
+
 impl fmt::Display for Integrator {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -205,6 +234,39 @@ mod tests {
                 "{integrator}: v₁ = v₀ + a h"
             );
         }
+    }
+
+    #[test]
+    fn drag_decays_just_below_each_schemes_limit_and_grows_just_above_it() {
+        use crate::{Bodies, LinearDrag, Stepper, TimeStep};
+        use nalgebra::Vector2;
+        // The schemes themselves, stepped on v̇ = −(b/m) v: |v| after 200 steps.
+        let (b, m) = (0.2, 1e-3);
+        let k = b / m;
+        let speed_after = |integrator: Integrator, kh: f64| {
+            let stepper = Stepper::new(integrator, LinearDrag::new(b).unwrap()).unwrap();
+            let (mut x, mut v) = ([Vector2::zeros()], [Vector2::new(1.0, 0.0)]);
+            let inverse_masses = [1.0 / m];
+            let mut bodies = Bodies::new(&mut x, &mut v, &inverse_masses).unwrap();
+            for n in 0..200 {
+                let h = TimeStep::new(kh / k).unwrap();
+                stepper.step(&mut bodies, f64::from(n) * kh / k, h);
+            }
+            v[0].norm()
+        };
+        for integrator in Integrator::ALL {
+            let limit = integrator.decay_stability_limit();
+            if limit.is_infinite() {
+                assert!(speed_after(integrator, 1e3) <= 1.0, "{integrator}");
+                continue;
+            }
+            assert!(speed_after(integrator, 0.99 * limit) < 1.0, "{integrator}");
+            assert!(speed_after(integrator, 1.01 * limit) > 1.0, "{integrator}");
+        }
+        // RK4 has no real root (R > 0 on the real axis): its limit is where R comes back to 1.
+        let z = -Integrator::Rk4.decay_stability_limit();
+        let r = 1.0 + z + z * z / 2.0 + z.powi(3) / 6.0 + z.powi(4) / 24.0;
+        assert!((r - 1.0).abs() < 1e-12, "{r}");
     }
 
     #[test]

@@ -337,10 +337,12 @@ mod tests {
                     .max_by(|&x, &y| m[x][col].abs().partial_cmp(&m[y][col].abs()).unwrap())
                     .unwrap();
                 m.swap(col, pivot);
-                for row in col + 1..p {
-                    let f = m[row][col] / m[col][col];
-                    for k in col..=p {
-                        m[row][k] -= f * m[col][k];
+                let (upper, lower) = m.split_at_mut(col + 1);
+                let pivot_row = &upper[col];
+                for row in lower.iter_mut() {
+                    let f = row[col] / pivot_row[col];
+                    for (x, y) in row[col..].iter_mut().zip(&pivot_row[col..]) {
+                        *x -= f * y;
                     }
                 }
             }

@@ -378,7 +378,7 @@ where
         let held: Vec<usize> = (0..stack.rows.len()).filter(|&c| !fast[c]).collect();
         self.save_free(&mut stack);
         let mut forced = vec![false; stack.rows.len()];
-        self.hold(&stack, &held, s, &mut forced);
+        self.hold(&mut stack, &held, s, &mut forced);
         for (p, f) in pushed.iter_mut().zip(&forced) {
             *p |= *f;
         }
@@ -395,7 +395,52 @@ where
     /// whole problem again from there: Newton's method on the contacts' complementarity
     /// conditions, so that a contact the last round pushed too hard gets less (a rocking
     /// cluster on three members) and one it left closing more.
-    fn hold(&mut self, stack: &Stack<T, D>, held: &[usize], s: T, pushed: &mut [bool]) {
+    fn hold(&mut self, stack: &mut Stack<T, D>, held: &[usize], s: T, pushed: &mut [bool]) {
+        self.hold_rounds(stack, held, s, pushed);
+        let closing = self.closing(stack, held, s);
+        if closing.is_empty() {
+            return;
+        }
+        // Jammed: the rotation over the rest of the step brings members into surfaces on
+        // several sides, which neither the rounds nor a push through the centres can
+        // stop. The bodies of the rows still closing stop at `s` (an inelastic impulse:
+        // energy only falls), and the hold starts again from there; a body at rest turns
+        // only as fast as the step's forces turn it, which the rounds hold.
+        let mut stop = Changes::new(stack.parts.len());
+        for &c in &closing {
+            for (e, _) in stack.ends(c) {
+                stop.impulse[e.part] = match stack.parts[e.part].side {
+                    Side::Ball(i) => (
+                        -self.balls.seg_v[i] * self.balls.mass[i],
+                        <Const<D> as Space<T, D>>::angular_zero(),
+                    ),
+                    Side::Cluster(k) => {
+                        let start = &self.clusters.list[k].start;
+                        (-start.velocity() * start.mass(), -start.angular_momentum())
+                    }
+                };
+            }
+        }
+        self.strike(stack, &stop);
+        self.save_free(stack);
+        self.hold_rounds(stack, held, s, pushed);
+    }
+
+    /// The rows of `held` that close faster than their targets by more than the hold's
+    /// tolerance.
+    fn closing(&self, stack: &Stack<T, D>, held: &[usize], s: T) -> Vec<usize> {
+        let rest = self.h - s;
+        let done = self.rules.floor * T::lit(0.25);
+        (held.iter().copied())
+            .filter(|&c| {
+                let row = &stack.rows[c];
+                self.relative(stack, c, Phase::Chord).dot(&row.normal) - row.gap / rest > done
+            })
+            .collect()
+    }
+
+    /// The rounds of [`Self::hold`], then [`Self::central`].
+    fn hold_rounds(&mut self, stack: &Stack<T, D>, held: &[usize], s: T, pushed: &mut [bool]) {
         let rest = self.h - s;
         let targets: Vec<T> = held.iter().map(|&c| stack.rows[c].gap / rest).collect();
         let done = self.rules.floor * T::lit(0.25);
@@ -422,7 +467,75 @@ where
             let changes = Self::changes(stack, held, &total, &mut unused);
             self.push(stack, &changes);
         }
-        Self::changes(stack, held, &total, pushed);
+        let mut changes = Self::changes(stack, held, &total, pushed);
+        if self.central(stack, held, &targets, done, &mut changes, pushed) {
+            self.push(stack, &changes);
+        }
+    }
+
+    /// The hold's last resort, when its rounds leave a row of `held` closing faster than
+    /// its target by more than `done`: pushes through the centres of mass, added to
+    /// `changes`; returns whether it pushed.
+    ///
+    /// The rounds converge while the rotation the force adds over the rest of the step
+    /// is small. A body that turns through a large angle in it (a cluster struck at
+    /// hundreds of m/s, spinning at thousands of rad/s) can leave a chord closing that
+    /// the first order does not see: its member touches a wall and moves away from it
+    /// now, but its rotation brings it back within the step. A push through a body's
+    /// centre of mass moves the chords of all its points by the same `P/m`, exactly (its
+    /// rotation does not see it), so one exact solve of that linear problem stops every
+    /// such row. Every hold must end with nothing closing beyond the floor: a hold
+    /// restarts its bodies free of earlier holds, so a row it left closing would be found
+    /// again at the same instant and held the same way, without end. The push gives no
+    /// torque, so it is no contact force; it acts only where the rounds fail.
+    fn central(
+        &mut self,
+        stack: &Stack<T, D>,
+        held: &[usize],
+        targets: &[T],
+        done: T,
+        changes: &mut Changes<T, D>,
+        pushed: &mut [bool],
+    ) -> bool {
+        let closing: Vec<T> = (held.iter().zip(targets))
+            .map(|(&c, &t)| {
+                self.relative(stack, c, Phase::Chord)
+                    .dot(&stack.rows[c].normal)
+                    - t
+            })
+            .collect();
+        if closing.iter().all(|&u| u <= done) {
+            return false;
+        }
+        // A_cd = Σ over shared bodies σ_c σ_d n_c·n_d / m: the change of row c's approach
+        // under a unit push along row d's normal through the centres of mass.
+        let n = held.len();
+        let mut a = vec![T::zero(); n * n];
+        for (r, &c) in held.iter().enumerate() {
+            for (q, &d) in held.iter().enumerate() {
+                let (nc, nd) = (&stack.rows[c].normal, &stack.rows[d].normal);
+                for (ec, sc) in stack.ends(c) {
+                    for (_, sd) in stack.ends(d).filter(|(e, _)| e.part == ec.part) {
+                        a[r * n + q] += sc * sd * nc.dot(nd) * stack.parts[ec.part].inverse_mass;
+                    }
+                }
+            }
+        }
+        let q: Vec<T> = closing.iter().map(|&u| -u).collect();
+        let mut lambda = vec![T::zero(); n];
+        self.lcp
+            .solve(&a, &q, self.rules.floor * T::lit(1e-3), &mut lambda);
+        for (&c, &l) in held.iter().zip(&lambda) {
+            if l <= T::zero() {
+                continue;
+            }
+            let p = -stack.rows[c].normal * l;
+            for (e, sign) in stack.ends(c) {
+                changes.impulse[e.part].0 += p * sign;
+            }
+            pushed[c] = true;
+        }
+        true
     }
 
     /// Enters `side` into the stack (once), restarted at `s` free of the step's earlier
