@@ -95,9 +95,6 @@ where
     /// The smallest side of a periodic border: a cluster may span at most half of it
     /// (see [`Clusters::check_span`]).
     pub(crate) period: Option<T>,
-    /// The integrator's chord weight `w` (`Integrator::chord_weight`): a held segment's
-    /// end motion has its push `1/w` times (see the module documentation).
-    pub(crate) chord_weight: T,
 }
 
 /// A change of a rigid body's motion: the velocity of its centre of mass and its angular
@@ -372,14 +369,12 @@ where
     Const<D>: Space<T, D>,
 {
     /// No clusters yet, for a run with the signed linear `drag` coefficient, in a periodic
-    /// border whose smallest side is `period`, with an integrator of chord weight
-    /// `chord_weight`.
-    pub(crate) fn new(drag: T, period: Option<T>, chord_weight: T) -> Self {
+    /// border whose smallest side is `period`.
+    pub(crate) fn new(drag: T, period: Option<T>) -> Self {
         Self {
             list: Vec::new(),
             drag,
             period,
-            chord_weight,
         }
     }
 

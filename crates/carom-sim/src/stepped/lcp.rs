@@ -282,19 +282,37 @@ impl<T: Real> Lcp<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use carom_broad::scenes::SplitMix64;
 
-    /// A deterministic generator of numbers in `[−1, 1)` (SplitMix64).
-    struct Numbers(u64);
+    /// Deterministic numbers in `[−1, 1)`, from carom-broad's scene generator.
+    struct Numbers(SplitMix64);
 
     impl Numbers {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        fn new(seed: u64) -> Self {
+            Self(SplitMix64::new(seed))
         }
+
+        fn next(&mut self) -> f64 {
+            self.0.range(-1.0, 1.0)
+        }
+    }
+
+    /// Asserts that `lambda` solves the problem: non-negative impulses, non-negative
+    /// margins, and no impulse where a margin is open.
+    fn assert_complementary(a: &[f64], q: &[f64], lambda: &[f64], trial: usize) {
+        let w = margins(a, q, lambda);
+        assert!(
+            lambda.iter().all(|&l| l >= 0.0),
+            "trial {trial}: {lambda:?}"
+        );
+        assert!(
+            w.iter().all(|&v| v >= -1e-9),
+            "trial {trial}: margins {w:?}"
+        );
+        assert!(
+            lambda.iter().zip(&w).all(|(l, v)| (l * v).abs() <= 1e-9),
+            "trial {trial}: complementarity {lambda:?} {w:?}"
+        );
     }
 
     /// `A = J W Jᵀ` for `n` contacts on `m` degrees of freedom with inverse masses `w`.
@@ -365,7 +383,7 @@ mod tests {
 
     #[test]
     fn random_positive_definite_problems_match_every_passive_set_tried() {
-        let mut rng = Numbers(11);
+        let mut rng = Numbers::new(11);
         let mut lcp = Lcp::default();
         for trial in 0..300 {
             let n = 1 + trial % 7;
@@ -390,7 +408,7 @@ mod tests {
     fn dependent_contacts_give_the_unique_margins_with_non_negative_impulses() {
         // Three contacts on two degrees of freedom (a flat body on three supports in a
         // plane: vertical motion and rotation), twice as many as independent ones.
-        let mut rng = Numbers(5);
+        let mut rng = Numbers::new(5);
         let mut lcp = Lcp::default();
         for trial in 0..200 {
             let n = 3 + trial % 4;
@@ -404,16 +422,7 @@ mod tests {
             let q = vec![-1.0; n];
             let mut lambda = vec![0.0; n];
             lcp.solve(&a, &q, 1e-12, &mut lambda);
-            assert!(lambda.iter().all(|&l| l >= 0.0), "{lambda:?}");
-            let w = margins(&a, &q, &lambda);
-            assert!(
-                w.iter().all(|&v| v >= -1e-9),
-                "trial {trial}: margins {w:?}"
-            );
-            assert!(
-                lambda.iter().zip(&w).all(|(l, v)| (l * v).abs() <= 1e-9),
-                "trial {trial}: complementarity {lambda:?} {w:?}"
-            );
+            assert_complementary(&a, &q, &lambda, trial);
         }
     }
 
@@ -422,7 +431,7 @@ mod tests {
         // More contacts than degrees of freedom (a 3D cluster in three pockets: nine
         // contacts on six), with margins no single independent set of them satisfies:
         // q = −A λ* + s with λ*, s >= 0, so λ* is feasible and a solution exists.
-        let mut rng = Numbers(17);
+        let mut rng = Numbers::new(17);
         let mut lcp = Lcp::default();
         for trial in 0..300 {
             let m = 2 + trial % 5;
@@ -435,16 +444,7 @@ mod tests {
             let q: Vec<f64> = (0..n).map(|i| -pushed[i] + rng.next().max(0.0)).collect();
             let mut lambda = vec![0.0; n];
             assert!(lcp.solve(&a, &q, 1e-12, &mut lambda), "trial {trial}");
-            let w = margins(&a, &q, &lambda);
-            assert!(lambda.iter().all(|&l| l >= 0.0), "{lambda:?}");
-            assert!(
-                w.iter().all(|&v| v >= -1e-9),
-                "trial {trial}: margins {w:?}"
-            );
-            assert!(
-                lambda.iter().zip(&w).all(|(l, v)| (l * v).abs() <= 1e-9),
-                "trial {trial}: complementarity {lambda:?} {w:?}"
-            );
+            assert_complementary(&a, &q, &lambda, trial);
         }
     }
 

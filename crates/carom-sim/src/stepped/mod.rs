@@ -54,7 +54,7 @@ mod stack;
 mod stick;
 mod sweep;
 
-use carom_geometry::Border;
+use carom_geometry::{Ball, Border};
 use carom_integrate::{Bodies, ForceField, Integrator, Stepper, TimeStep};
 use carom_math::{Real, Space, Vector, ensure_finite_vector};
 use carom_toi::Direction;
@@ -246,11 +246,7 @@ where
             stepper,
             rules,
             rest: RestSets::new(n),
-            clusters: Clusters::new(
-                drag,
-                periodic.as_ref().map(|b| b.extents().min()),
-                T::lit(integrator.chord_weight()),
-            ),
+            clusters: Clusters::new(drag, periodic.as_ref().map(|b| b.extents().min())),
             changed: Vec::new(),
             sweep,
             queue: EventQueue::new(),
@@ -730,11 +726,9 @@ where
         let (x, r) = (b.position_at(i, s), b.radius[i]);
         let tolerance = T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (x.amax() + r);
         if let Some(border) = &self.border {
-            for axis in 0..D {
-                for (upper, gap) in [
-                    (false, x[axis] - r - border.min()[axis]),
-                    (true, border.max()[axis] - x[axis] - r),
-                ] {
+            let gaps = border.wall_gaps(&Ball::new_unchecked(x, r));
+            for (axis, (below, above)) in gaps.into_iter().enumerate() {
+                for (upper, gap) in [(false, below), (true, above)] {
                     if gap <= tolerance {
                         let mut normal = Vector::zeros();
                         normal[axis] = if upper { T::one() } else { -T::one() };
@@ -766,17 +760,13 @@ where
             .map(|&c| c as usize - n)
             .chain(boxes.into_iter().flatten());
         for k in box_ids {
-            let obb = self.boxes.at(k, s);
-            let shift = self.periodic.map_or_else(Vector::zeros, |p| {
-                p.minimum_image(&(obb.center() - x)) - (obb.center() - x)
-            });
-            let local = obb.to_local(&(x - shift));
-            let q = obb.to_world(&local.inf(&obb.half_extents()).sup(&-obb.half_extents())) + shift;
-            let d = (q - x).norm();
-            if d > T::zero() && d - r <= tolerance {
+            let Some((normal, d)) = self.boxes.nearest(k, s, &x, self.periodic.as_ref()) else {
+                continue;
+            };
+            if d - r <= tolerance {
                 out.push(Touch {
                     support: Support::Box(k as u32),
-                    normal: (q - x) / d,
+                    normal,
                     velocity: self.boxes.vel[k],
                 });
             }

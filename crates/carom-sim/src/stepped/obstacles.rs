@@ -6,6 +6,7 @@
 //! the end of the step is recomputed from the time its velocity was last set (`k·dt`
 //! style, no running sum), so a box at constant velocity does not drift.
 
+use carom_geometry::query::PointQuery;
 use carom_geometry::{Aabb, Border, Obb};
 use carom_math::{Real, Vector};
 
@@ -46,6 +47,25 @@ impl<T: Real, const D: usize> BoxArrays<T, D> {
     /// Box `k` at in-step time `s`.
     pub(crate) fn at(&self, k: usize, s: T) -> Obb<T, D> {
         self.shape[k].translated(&(self.vel[k] * s))
+    }
+
+    /// From `x` towards the nearest point of box `k` at in-step time `s` (of its periodic
+    /// image nearest `x` in a `periodic` border): the unit direction and the distance;
+    /// `None` when `x` is inside the box.
+    pub(crate) fn nearest(
+        &self,
+        k: usize,
+        s: T,
+        x: &Vector<T, D>,
+        periodic: Option<&Border<T, D>>,
+    ) -> Option<(Vector<T, D>, T)> {
+        let obb = self.at(k, s);
+        let shift = periodic.map_or_else(Vector::zeros, |border| {
+            border.minimum_image(&(obb.center() - x)) - (obb.center() - x)
+        });
+        let q = obb.closest_point(&(x - shift)) + shift;
+        let d = (q - x).norm();
+        (d > T::zero()).then(|| ((q - x) / d, d))
     }
 
     /// The box swept by box `k` over the in-step times `[a, b]`.

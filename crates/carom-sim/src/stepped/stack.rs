@@ -52,6 +52,7 @@
 //! hold never adds energy, to first order in the rotation. The impacts are inelastic
 //! impulses at `s`, which only take energy.
 
+use carom_geometry::Ball;
 use carom_integrate::ForceField;
 use carom_math::{Real, Space, Vector};
 use nalgebra::Const;
@@ -156,6 +157,44 @@ where
         self.parts.iter().position(|p| p.side == side)
     }
 
+    /// The Delassus matrix of `rows` (row-major, `rows.len()` square):
+    /// `A_cd = Σ over shared bodies σ_c σ_d (n_c·n_d/m + (a_c × n_c)·I⁻¹(a_d × n_d))`,
+    /// how a unit push along row `d`'s normal changes the approach at row `c`; pushed
+    /// through the centres of mass, the angular term drops.
+    fn delassus(&self, rows: &[usize], push: Push) -> Vec<T> {
+        let n = rows.len();
+        let mut a = vec![T::zero(); n * n];
+        for (r, &c) in rows.iter().enumerate() {
+            for (q, &d) in rows.iter().enumerate().skip(r) {
+                let (nc, nd) = (&self.rows[c].normal, &self.rows[d].normal);
+                let mut sum = T::zero();
+                for (ec, sc) in self.ends(c) {
+                    for (ed, sd) in self.ends(d).filter(|(e, _)| e.part == ec.part) {
+                        let part = &self.parts[ec.part];
+                        let angular = match push {
+                            Push::ThroughCentres => T::zero(),
+                            Push::AtContacts => {
+                                let ac = <Const<D> as Space<T, D>>::cross(&ec.arm, nc);
+                                let ad = <Const<D> as Space<T, D>>::cross(&ed.arm, nd);
+                                <Const<D> as Space<T, D>>::angular_dot(
+                                    &ac,
+                                    &<Const<D> as Space<T, D>>::inertia_apply(
+                                        &part.inverse_inertia,
+                                        &ad,
+                                    ),
+                                )
+                            }
+                        };
+                        sum += sc * sd * (nc.dot(nd) * part.inverse_mass + angular);
+                    }
+                }
+                a[r * n + q] = sum;
+                a[q * n + r] = sum;
+            }
+        }
+        a
+    }
+
     /// The ends of row `c` with their signs: `+1` for the end a push moves along `−n`.
     fn ends(&self, c: usize) -> impl Iterator<Item = (End<T, D>, T)> + '_ {
         let row = &self.rows[c];
@@ -240,6 +279,15 @@ impl<T: Real, const D: usize> Seed<T, D> {
             _ => false,
         }
     }
+}
+
+/// Where a stack's impulses act on its bodies (see [`Stack::delassus`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Push {
+    /// At the contact points: force and torque.
+    AtContacts,
+    /// Through the centres of mass: force only (`Contacts::central`).
+    ThroughCentres,
 }
 
 /// Which velocities a phase acts on.
@@ -396,8 +444,16 @@ where
     /// conditions, so that a contact the last round pushed too hard gets less (a rocking
     /// cluster on three members) and one it left closing more.
     fn hold(&mut self, stack: &mut Stack<T, D>, held: &[usize], s: T, pushed: &mut [bool]) {
-        self.hold_rounds(stack, held, s, pushed);
-        let closing = self.closing(stack, held, s);
+        let rest = self.h - s;
+        let targets: Vec<T> = held.iter().map(|&c| stack.rows[c].gap / rest).collect();
+        // What the rounds leave closing beyond their target counts as closing.
+        let done = self.rules.floor * T::lit(0.25);
+        self.hold_rounds(stack, held, &targets, done, pushed);
+        let excess = self.excess(stack, held, &targets);
+        let closing: Vec<usize> = (held.iter().zip(&excess))
+            .filter(|&(_, &u)| u > done)
+            .map(|(&c, _)| c)
+            .collect();
         if closing.is_empty() {
             return;
         }
@@ -423,34 +479,38 @@ where
         }
         self.strike(stack, &stop);
         self.save_free(stack);
-        self.hold_rounds(stack, held, s, pushed);
+        self.hold_rounds(stack, held, &targets, done, pushed);
     }
 
-    /// The rows of `held` that close faster than their targets by more than the hold's
-    /// tolerance.
-    fn closing(&self, stack: &Stack<T, D>, held: &[usize], s: T) -> Vec<usize> {
-        let rest = self.h - s;
-        let done = self.rules.floor * T::lit(0.25);
-        (held.iter().copied())
-            .filter(|&c| {
-                let row = &stack.rows[c];
-                self.relative(stack, c, Phase::Chord).dot(&row.normal) - row.gap / rest > done
+    /// How much faster than its target (the speed that closes its gap over the rest of
+    /// the step) each row of `held` closes along its chords now.
+    fn excess(&self, stack: &Stack<T, D>, held: &[usize], targets: &[T]) -> Vec<T> {
+        (held.iter().zip(targets))
+            .map(|(&c, &t)| {
+                self.relative(stack, c, Phase::Chord)
+                    .dot(&stack.rows[c].normal)
+                    - t
             })
             .collect()
     }
 
-    /// The rounds of [`Self::hold`], then [`Self::central`].
-    fn hold_rounds(&mut self, stack: &Stack<T, D>, held: &[usize], s: T, pushed: &mut [bool]) {
-        let rest = self.h - s;
-        let targets: Vec<T> = held.iter().map(|&c| stack.rows[c].gap / rest).collect();
-        let done = self.rules.floor * T::lit(0.25);
+    /// The rounds of [`Self::hold`] towards `targets` until no row exceeds its target by
+    /// more than `done`, then [`Self::central`].
+    fn hold_rounds(
+        &mut self,
+        stack: &Stack<T, D>,
+        held: &[usize],
+        targets: &[T],
+        done: T,
+        pushed: &mut [bool],
+    ) {
         let mut total = vec![Vector::<T, D>::zeros(); held.len()];
         let mut unused = vec![false; stack.rows.len()];
         for _ in 0..HOLD_ROUNDS {
             let mut chords: Vec<_> = (0..stack.rows.len())
                 .map(|c| self.relative(stack, c, Phase::Chord))
                 .collect();
-            let left = (held.iter().zip(&targets))
+            let left = (held.iter().zip(targets))
                 .map(|(&c, &t)| chords[c].dot(&stack.rows[c].normal) - t)
                 .fold(T::zero(), T::max);
             if left <= done {
@@ -463,12 +523,12 @@ where
                 });
                 chords[c] -= moved;
             }
-            total = self.impulses(stack, held, &chords, &targets);
+            total = self.impulses(stack, held, &chords, targets);
             let changes = Self::changes(stack, held, &total, &mut unused);
             self.push(stack, &changes);
         }
         let mut changes = Self::changes(stack, held, &total, pushed);
-        if self.central(stack, held, &targets, done, &mut changes, pushed) {
+        if self.central(stack, held, targets, done, &mut changes, pushed) {
             self.push(stack, &changes);
         }
     }
@@ -497,32 +557,13 @@ where
         changes: &mut Changes<T, D>,
         pushed: &mut [bool],
     ) -> bool {
-        let closing: Vec<T> = (held.iter().zip(targets))
-            .map(|(&c, &t)| {
-                self.relative(stack, c, Phase::Chord)
-                    .dot(&stack.rows[c].normal)
-                    - t
-            })
-            .collect();
-        if closing.iter().all(|&u| u <= done) {
+        let excess = self.excess(stack, held, targets);
+        if excess.iter().all(|&u| u <= done) {
             return false;
         }
-        // A_cd = Σ over shared bodies σ_c σ_d n_c·n_d / m: the change of row c's approach
-        // under a unit push along row d's normal through the centres of mass.
-        let n = held.len();
-        let mut a = vec![T::zero(); n * n];
-        for (r, &c) in held.iter().enumerate() {
-            for (q, &d) in held.iter().enumerate() {
-                let (nc, nd) = (&stack.rows[c].normal, &stack.rows[d].normal);
-                for (ec, sc) in stack.ends(c) {
-                    for (_, sd) in stack.ends(d).filter(|(e, _)| e.part == ec.part) {
-                        a[r * n + q] += sc * sd * nc.dot(nd) * stack.parts[ec.part].inverse_mass;
-                    }
-                }
-            }
-        }
-        let q: Vec<T> = closing.iter().map(|&u| -u).collect();
-        let mut lambda = vec![T::zero(); n];
+        let a = stack.delassus(held, Push::ThroughCentres);
+        let q: Vec<T> = excess.iter().map(|&u| -u).collect();
+        let mut lambda = vec![T::zero(); held.len()];
         self.lcp
             .solve(&a, &q, self.rules.floor * T::lit(1e-3), &mut lambda);
         for (&c, &l) in held.iter().zip(&lambda) {
@@ -648,39 +689,32 @@ where
         }
     }
 
-    /// The walls and boxes ball `x` could touch at `s`: `(unit normal from the ball into
-    /// the surface, surface velocity, gap)` for every wall of the border and the nearest
-    /// point of every box (at its periodic image nearest the ball).
-    pub(super) fn surfaces_of(&self, x: usize, s: T) -> Vec<(Vector<T, D>, Vector<T, D>, T)> {
+    /// Calls `f` with every wall and box ball `x` could touch at `s`: `(unit normal from
+    /// the ball into the surface, surface velocity, gap)` for every wall of the border
+    /// and the nearest point of every box (at its periodic image nearest the ball).
+    pub(super) fn for_each_surface(
+        &self,
+        x: usize,
+        s: T,
+        mut f: impl FnMut(Vector<T, D>, Vector<T, D>, T),
+    ) {
         let b = &*self.balls;
         let (p, r) = (b.position_at(x, s), b.radius[x]);
-        let mut out = Vec::new();
         if let Some(border) = self.border {
-            for axis in 0..D {
-                for (upper, gap) in [
-                    (false, p[axis] - r - border.min()[axis]),
-                    (true, border.max()[axis] - p[axis] - r),
-                ] {
+            let gaps = border.wall_gaps(&Ball::new_unchecked(p, r));
+            for (axis, (below, above)) in gaps.into_iter().enumerate() {
+                for (sign, gap) in [(-T::one(), below), (T::one(), above)] {
                     let mut n = Vector::zeros();
-                    n[axis] = if upper { T::one() } else { -T::one() };
-                    out.push((n, Vector::zeros(), gap));
+                    n[axis] = sign;
+                    f(n, Vector::zeros(), gap);
                 }
             }
         }
         for k in 0..self.boxes.len() {
-            let obb = self.boxes.at(k, s);
-            let shift = self.periodic.map_or_else(Vector::zeros, |border| {
-                border.minimum_image(&(obb.center() - p)) - (obb.center() - p)
-            });
-            let local = obb.to_local(&(p - shift));
-            let half = obb.half_extents();
-            let q = obb.to_world(&local.inf(&half).sup(&-half)) + shift;
-            let d = (q - p).norm();
-            if d > T::zero() {
-                out.push(((q - p) / d, self.boxes.vel[k], d - r));
+            if let Some((n, d)) = self.boxes.nearest(k, s, &p, self.periodic) {
+                f(n, self.boxes.vel[k], d - r);
             }
         }
-        out
     }
 
     /// Adds the contacts of ball `x` of body `k` of the stack at `s` that touch or close
@@ -702,7 +736,7 @@ where
             arm: p + n * r - centre,
             lever: n * r,
         };
-        for (n, v, gap) in self.surfaces_of(x, s) {
+        self.for_each_surface(x, s, |n, v, gap| {
             if near(gap, (chord - v).dot(&n)) {
                 stack.rows.push(Row {
                     end: end(&n),
@@ -711,7 +745,7 @@ where
                     gap: gap.max(T::zero()),
                 });
             }
-        }
+        });
         let mut candidates = core::mem::take(self.candidates);
         let path = path_box(&p, &self.balls.pos[x], r + tolerance);
         self.sweep.candidates(x, &path, &mut candidates);
@@ -849,29 +883,7 @@ where
         if n == 0 {
             return Vec::new();
         }
-        // The Delassus matrix: A_cd = Σ over shared bodies σ_c σ_d (n_c·n_d/m
-        // + (a_c × n_c)·I⁻¹(a_d × n_d)), how a unit push at d changes the approach at c.
-        let mut a = vec![T::zero(); n * n];
-        for (r, &c) in rows.iter().enumerate() {
-            for (q, &d) in rows.iter().enumerate().skip(r) {
-                let (nc, nd) = (&stack.rows[c].normal, &stack.rows[d].normal);
-                let mut sum = T::zero();
-                for (ec, sc) in stack.ends(c) {
-                    for (ed, sd) in stack.ends(d).filter(|(e, _)| e.part == ec.part) {
-                        let part = &stack.parts[ec.part];
-                        let ac = <Const<D> as Space<T, D>>::cross(&ec.arm, nc);
-                        let ad = <Const<D> as Space<T, D>>::cross(&ed.arm, nd);
-                        let angular = <Const<D> as Space<T, D>>::angular_dot(
-                            &ac,
-                            &<Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, &ad),
-                        );
-                        sum += sc * sd * (nc.dot(nd) * part.inverse_mass + angular);
-                    }
-                }
-                a[r * n + q] = sum;
-                a[q * n + r] = sum;
-            }
-        }
+        let a = stack.delassus(rows, Push::AtContacts);
         let approach: Vec<T> = (rows.iter())
             .map(|&c| relative[c].dot(&stack.rows[c].normal))
             .collect();
@@ -1013,7 +1025,7 @@ where
     /// explicit Euler (`w = 0`) no force within the step moves a chord: impulses at the
     /// segment start.
     fn push(&mut self, stack: &Stack<T, D>, changes: &Changes<T, D>) {
-        let w = self.clusters.chord_weight;
+        let w = T::lit(self.stepper.integrator().chord_weight());
         let drag = self.clusters.drag;
         let (start_share, end_share) = if w > T::zero() {
             (T::zero(), T::one() / w)

@@ -268,15 +268,15 @@ where
         for &m in &self.clusters.list[c].members {
             let m = m as usize;
             let tolerance = T::lit(1e-9) * b.radius[m];
-            for (normal, v, gap) in self.surfaces_of(m, s) {
+            self.for_each_surface(m, s, |normal, v, gap| {
                 if gap > tolerance || v != surface_velocity || (normal - n).norm() > T::lit(1e-9) {
-                    continue;
+                    return;
                 }
                 let q = b.seg_x[m] + n * b.radius[m];
                 lo = lo.inf(&q);
                 hi = hi.sup(&q);
                 several = true;
-            }
+            });
         }
         if !several {
             return *point;
