@@ -53,6 +53,7 @@ mod rest;
 mod stack;
 mod stick;
 mod sweep;
+mod wedge;
 
 use carom_geometry::{Ball, Border};
 use carom_integrate::{Bodies, ForceField, Integrator, Stepper, TimeStep};
@@ -70,8 +71,9 @@ use self::obstacles::BoxArrays;
 use self::queue::EventQueue;
 use self::response::{Contacts, Effect, RestSets, Rules, Surface};
 use self::rest::{Support, Touch};
-use self::stack::Groups;
+use self::stack::{Groups, SeedOther};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
+use self::wedge::{CRUSH_CONTACTS, Repeat, Repeats};
 
 /// Escapees per parallel task of the step's first predictions (each is a broad-phase
 /// query and a few times of impact: 1.4 µs on average, timed on a 1e5-ball gas).
@@ -156,6 +158,8 @@ where
     lcp: Lcp<T>,
     /// The bodies held together in the current step (see `stack`).
     groups: Groups,
+    /// Each ball's contacts at one instant in the current step (see `wedge`).
+    repeats: Repeats<T>,
     clock: Clock<T>,
     counters: Counters,
     stats: StepStats,
@@ -257,6 +261,7 @@ where
             touches: [Vec::new(), Vec::new()],
             lcp: Lcp::default(),
             groups: Groups::new(n),
+            repeats: Repeats::new(n),
             clock: Clock {
                 dt,
                 k: 0,
@@ -397,6 +402,7 @@ where
         };
         self.rest.clear();
         self.groups.clear();
+        self.repeats.clear();
         let stepper = &self.stepper;
         // Per chunk: the segments start where the balls are, then the balls are stepped
         // and the chords follow from where they end.
@@ -614,6 +620,33 @@ where
             }
     }
 
+    /// Notes the event's contacts (see `wedge`): whether a ball of it is wedged.
+    ///
+    /// # Errors
+    /// A ball of it is crushed.
+    fn wedged(&mut self, e: &Event<T, D>, h: T, t0: T) -> Result<bool, SimError> {
+        let [i, other] = e.balls();
+        let instant = h * T::lit(1e-9);
+        let mut repeat = self.repeats.note(i, e.time, instant);
+        if other != i {
+            repeat = repeat.max(self.repeats.note(other, e.time, instant));
+        }
+        if repeat == Repeat::Crushed {
+            let by = match e.target {
+                Target::Ball(j) => format!("balls[{j}]"),
+                Target::Border => "the border".to_string(),
+                Target::Box(k) => format!("boxes[{k}]"),
+            };
+            return Err(SimError {
+                time: ((t0 + e.time) * self.clock.sign + T::zero()).to_f64(),
+                message: format!(
+                    "balls[{i}] is crushed: more than {CRUSH_CONTACTS} contacts at one instant (the last with {by}), even held against all of them at once: it cannot give way (a kinematic box pressing it into the border or another box from every side it could leave by)"
+                ),
+            });
+        }
+        Ok(repeat == Repeat::Wedged)
+    }
+
     /// Processes one event: the balls it changed go to `self.changed` (a cluster changes
     /// all its members, a hold every ball of its stack); returns the collision to report,
     /// if any.
@@ -632,6 +665,7 @@ where
         let in_cluster = |b: &BallArrays<T, D>, k: usize| Clusters::of(b, k).is_some();
         let clustered = in_cluster(&self.balls, i) || in_cluster(&self.balls, other);
         let grouped_i = self.groups.grouped(i);
+        let wedged = self.wedged(e, h, t0)?;
         self.changed.clear();
         let mut contacts = Contacts {
             balls: &mut self.balls,
@@ -663,7 +697,9 @@ where
                     && contacts.balls.restitution[i].min(contacts.balls.restitution[j])
                         == T::zero();
                 let grouped = contacts.groups.grouped(i) || contacts.groups.grouped(j);
-                let effect = if clustered || sticks || grouped {
+                let effect = if wedged && !clustered && !sticks {
+                    contacts.wedged(i, SeedOther::Ball(j), e.time)
+                } else if clustered || sticks || grouped {
                     contacts
                         .stuck_pair(i, j, &e.shift, e.time, &e.normal)
                         .map_err(stuck_error)?
@@ -672,25 +708,23 @@ where
                 };
                 (effect, Collision::BallBall { time, i, j })
             }
-            Target::Border => (
-                if clustered || grouped_i {
-                    contacts.stuck_surface(i, Surface::Wall, &e.normal, e.time)
+            Target::Border | Target::Box(_) => {
+                let (surface, collision) = match e.target {
+                    Target::Box(k) => {
+                        let k = k as usize;
+                        let surface = Surface::Box(k, self.boxes.vel[k]);
+                        (surface, Collision::BallBox { time, i, k })
+                    }
+                    _ => (Surface::Wall, Collision::BallBorder { time, i }),
+                };
+                let effect = if wedged && !clustered {
+                    contacts.wedged(i, SeedOther::Surface(e.normal), e.time)
+                } else if clustered || grouped_i {
+                    contacts.stuck_surface(i, surface, &e.normal, e.time)
                 } else {
-                    contacts.ball_surface(i, Surface::Wall, &e.normal, e.time)
-                },
-                Collision::BallBorder { time, i },
-            ),
-            Target::Box(k) => {
-                let k = k as usize;
-                let surface = Surface::Box(k, self.boxes.vel[k]);
-                (
-                    if clustered || grouped_i {
-                        contacts.stuck_surface(i, surface, &e.normal, e.time)
-                    } else {
-                        contacts.ball_surface(i, surface, &e.normal, e.time)
-                    },
-                    Collision::BallBox { time, i, k },
-                )
+                    contacts.ball_surface(i, surface, &e.normal, e.time)
+                };
+                (effect, collision)
             }
         };
         self.touches = touches;

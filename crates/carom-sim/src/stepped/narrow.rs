@@ -184,6 +184,20 @@ where
         Kinematics::new_unchecked(self.balls.chord[i], Vector::zeros())
     }
 
+    /// Whether a ball moving at `u` does not approach a surface moving at
+    /// `other_velocity` along `normal` (into it) by more than rounding or the resting
+    /// floor: no contact worth acting on.
+    fn not_approaching(
+        &self,
+        u: &Vector<T, D>,
+        other_velocity: &Vector<T, D>,
+        normal: &Vector<T, D>,
+    ) -> bool {
+        let approach = (u - other_velocity).dot(normal);
+        let rounding = T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm());
+        approach <= rounding || approach <= self.resting_floor
+    }
+
     /// Turns a time of impact into an event, or `None` if it is no contact worth acting on.
     #[allow(clippy::too_many_arguments)]
     fn event<F>(
@@ -208,10 +222,7 @@ where
             Status::NoHit => return Ok(None),
             Status::NotConverged => return Err(Overflow { ball: ball as u32 }),
         }
-        let u = &self.balls.chord[ball];
-        let approach = (u - other_velocity).dot(&toi.normal);
-        let rounding = T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm());
-        if approach <= rounding || approach <= self.resting_floor {
+        if self.not_approaching(&self.balls.chord[ball], other_velocity, &toi.normal) {
             return Ok(None);
         }
         let time = (s + toi.time).min(self.end);
@@ -332,12 +343,34 @@ where
         if (0..D).all(|k| lo[k] + margin < x[k].min(y[k]) && x[k].max(y[k]) + margin < hi[k]) {
             return Ok(None);
         }
-        let toi = ball_border(
-            &Ball::new_unchecked(x, r),
-            &self.kinematics(i),
+        let ball = Ball::new_unchecked(x, r);
+        let window = self.window(s);
+        // A wall the ball touches but does not approach (it slides along it, pressed in
+        // by rounding) is no contact, but `ball_border` reports the wall touched before
+        // any other: the walls are asked again without the chord's component along it,
+        // which changes no other wall's time (the walls are axis-aligned). Otherwise a
+        // ball sliding along one wall would pass through the next.
+        let mut u = b.chord[i];
+        let mut toi = ball_border(
+            &ball,
+            &Kinematics::new_unchecked(u, Vector::zeros()),
             border,
-            &self.window(s),
+            &window,
         );
+        for _ in 1..D {
+            if toi.status != Status::AlreadyTouching
+                || !self.not_approaching(&u, &Vector::zeros(), &toi.normal)
+            {
+                break;
+            }
+            u -= toi.normal * u.dot(&toi.normal);
+            toi = ball_border(
+                &ball,
+                &Kinematics::new_unchecked(u, Vector::zeros()),
+                border,
+                &window,
+            );
+        }
         self.event(
             &toi,
             s,

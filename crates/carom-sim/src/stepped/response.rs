@@ -335,7 +335,14 @@ where
                 for (k, ball, body) in [(0, i, ci), (1, j, cj)] {
                     let du = r.velocity[k] - body.velocity();
                     let dw = r.angular_velocity[k] - body.angular_velocity();
-                    self.balls.shift_chord(ball, h, &du, &dw, &n);
+                    // Both balls' velocities shift with their chords: the pair keeps its
+                    // momentum, and (gravity shifting both velocities alike from the
+                    // chords) its energy changes as the chords' does, never up. Setting
+                    // the normal component to the chord's, as a ball held on a surface
+                    // does, would add the step's remaining gravity `g (h − s)` along the
+                    // normal at every such contact (a milligram ball pressed between two
+                    // kilogram balls gave them 2 J in one step).
+                    self.balls.nudge(ball, h, &du, &dw);
                     self.rest.restart(ball, s, self.balls.chord[ball]);
                 }
             }

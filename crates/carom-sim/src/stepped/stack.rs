@@ -9,7 +9,10 @@
 //! surface moving at its chord (shock propagation, as for a ball on a held ball in
 //! `response`); walls and boxes are surfaces. A free ball takes part only with its walls,
 //! boxes and held balls below: its contacts with other free balls are the balls' own
-//! events. Every body of the stack restarts at the contact's instant `s` free of earlier
+//! events, except in the hold of a wedged ball ([`Approach::Any`], see `wedge`), which
+//! takes in the free balls touching it, and theirs, with every approaching contact
+//! (answered one at a time, a 1 mg ball squeezed between two 1 kg balls and a floor
+//! passes on a millionth of the push per contact). Every body of the stack restarts at the contact's instant `s` free of earlier
 //! holds of the step (see `clusters`: its physical state there, the force dropped), and
 //! the stack's contacts are solved in two phases:
 //!
@@ -60,7 +63,7 @@ use nalgebra::Const;
 use carom_response::RigidCluster;
 
 use super::clusters::{FREE, Motion};
-use super::response::Contacts;
+use super::response::{Contacts, Effect};
 use super::stick::Side;
 use super::sweep::path_box;
 use crate::engine::Angular;
@@ -145,6 +148,9 @@ where
 {
     /// The hold's instant (in-step time).
     s: T,
+    /// Which approaching contacts it takes in; with [`Approach::Any`] its free balls
+    /// bring in the free balls they touch too.
+    approach: Approach,
     parts: Vec<Part<T, D>>,
     rows: Vec<Row<T, D>>,
 }
@@ -281,6 +287,17 @@ impl<T: Real, const D: usize> Seed<T, D> {
     }
 }
 
+/// Which of a stack's approaching contacts a hold takes in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Approach {
+    /// Those no faster than support (and the seed): faster ones are collisions, each
+    /// answered by its own event with its restitution.
+    Slow,
+    /// All: the stack's balls are wedged (see `wedge`), and answering its contacts one at
+    /// a time would not end.
+    Any,
+}
+
 /// Where a stack's impulses act on its bodies (see [`Stack::delassus`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Push {
@@ -353,11 +370,21 @@ impl<T: Real, const D: usize, F: ForceField<T, D>> Contacts<'_, T, D, F>
 where
     Const<D>: Space<T, D>,
 {
-    /// Holds the stack around the contact `seed` at in-step time `s` (see the module
-    /// documentation).
-    pub(crate) fn hold_stack(&mut self, seed: Seed<T, D>, s: T) {
+    /// Free ball `i`, wedged at in-step time `s` (see `wedge`), touching `other`: the stack
+    /// around the contact held with every approaching contact taken in.
+    pub(crate) fn wedged(&mut self, i: usize, other: SeedOther<T, D>, s: T) -> Effect {
+        if s < self.h {
+            self.hold_stack(Seed { ball: i, other }, s, Approach::Any);
+        }
+        Effect::default()
+    }
+
+    /// Holds the stack around the contact `seed` at in-step time `s`, taking in the
+    /// contacts `approach` says (see the module documentation).
+    pub(crate) fn hold_stack(&mut self, seed: Seed<T, D>, s: T, approach: Approach) {
         let mut stack = Stack {
             s,
+            approach,
             parts: Vec::new(),
             rows: Vec::new(),
         };
@@ -409,7 +436,11 @@ where
         // answered: what it left closing, a cluster turning into a floor it struck, is
         // stopped here).
         let fast: Vec<bool> = (stack.rows.iter().zip(&start))
-            .map(|(row, u)| u.dot(&row.normal) > self.rules.support_speed && !seed.is(row))
+            .map(|(row, u)| {
+                stack.approach == Approach::Slow
+                    && u.dot(&row.normal) > self.rules.support_speed
+                    && !seed.is(row)
+            })
             .collect();
         // 1. Impacts: restitution 0 on the velocities at s, touching contacts only.
         let touching: Vec<usize> = (0..stack.rows.len())
@@ -785,7 +816,9 @@ where
                     });
                     continue;
                 }
-                (None, Side::Ball(_)) if !cluster_body => continue,
+                (None, Side::Ball(_)) if !cluster_body && stack.approach == Approach::Slow => {
+                    continue;
+                }
                 (None, _) => self.enter(stack, side, s),
             };
             // The contact point, on ball x's surface; ball j's position moved to x's image.

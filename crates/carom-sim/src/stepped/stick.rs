@@ -34,7 +34,7 @@ use nalgebra::Const;
 
 use super::clusters::{Clusters, FREE, Motion, StuckCluster};
 use super::response::{Contacts, Effect, Surface};
-use super::stack::{Seed, SeedOther};
+use super::stack::{Approach, Seed, SeedOther};
 
 /// One side of a contact: a free ball or a cluster.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -152,7 +152,7 @@ where
                     ball: i,
                     other: SeedOther::Ball(j),
                 };
-                self.hold_stack(seed, s);
+                self.hold_stack(seed, s, Approach::Slow);
             }
             return Ok(Effect { collided: true });
         }
@@ -183,7 +183,7 @@ where
                 ball: i,
                 other: SeedOther::Ball(j),
             };
-            self.hold_stack(seed, s);
+            self.hold_stack(seed, s, Approach::Slow);
         }
         Ok(effect)
     }
@@ -243,7 +243,7 @@ where
                 ball: i,
                 other: SeedOther::Surface(*n),
             };
-            self.hold_stack(seed, s);
+            self.hold_stack(seed, s, Approach::Slow);
         }
         effect
     }

@@ -1,0 +1,129 @@
+//! Telling a free ball **wedged** between contacts that keep answering each other at one
+//! instant, so that the engine solves them together instead.
+//!
+//! Contacts are answered one at a time. A ball pressed between two others, or between a
+//! ball and a wall, is answered by one contact, which sends it into the other, which sends
+//! it back, and so on. Without friction the approach shrinks geometrically and the chain
+//! ends within rounding; with friction a driving body (a heavy ball spinning against a
+//! light one on a wall) feeds every round a little tangential velocity that the next
+//! contact turns into a new approach, and the chain settles at a fixed approach instead
+//! of shrinking: fuzzed scenes ran the event budget out, a million contacts per step, all
+//! within 1e-11 s. A ball with more than [`WEDGE_CONTACTS`] contacts within
+//! [`Repeats::note`]'s tolerance of one instant is held as a stack (see `stack`): all its
+//! touching contacts at once, with the free balls it touches and theirs, restitution 0
+//! with friction, which leaves none of them approaching. The same holds a light ball
+//! squeezed between heavy ones (a 1 mg ball between two 1 kg balls and a floor), which
+//! one contact at a time passes on a millionth of the push per contact.
+//!
+//! No impulse frees a ball **crushed** by a kinematic box against the border, a static
+//! box or another kinematic box when the surfaces close on it from every side it could
+//! leave by (a box coming down parallel to the floor, or into a corner): the contacts
+//! come back however they are answered. A ball past [`CRUSH_CONTACTS`] contacts at one
+//! instant ends the run with an error naming it, as the event engine does for a cascade
+//! that does not end, instead of spending the event budget (a million contacts, tens of
+//! seconds) on every step. A box closing on a ball at a slant squeezes it out sideways
+//! (the wedge's hold finds that), which is no crush.
+
+use carom_math::Real;
+
+/// Contacts of one ball at one instant beyond which it is wedged. Elastic chains end in
+/// far fewer: a column of `k` balls settles in `k(k+1)/2` contacts, `k` for each ball.
+pub(crate) const WEDGE_CONTACTS: u32 = 256;
+
+/// Contacts of one ball at one instant beyond which it is crushed: four times the wedge
+/// limit, so that a wedge is held several times first.
+pub(crate) const CRUSH_CONTACTS: u32 = 64 * WEDGE_CONTACTS;
+
+/// What a ball's contacts at one instant say about it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum Repeat {
+    /// No more than [`WEDGE_CONTACTS`]: answered one at a time.
+    Free,
+    /// Wedged: to be held with all its contacts at once.
+    Wedged,
+    /// Crushed: no impulse frees it.
+    Crushed,
+}
+
+/// Per ball, the instant its recent contacts cluster around and how many it had there.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Repeats<T> {
+    anchor: Vec<T>,
+    count: Vec<u32>,
+    /// The balls with a non-zero count (to forget in [`Self::clear`]).
+    noted: Vec<u32>,
+}
+
+impl<T: Real> Repeats<T> {
+    /// No contacts yet, for `n` balls.
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            anchor: vec![T::zero(); n],
+            count: vec![0; n],
+            noted: Vec::new(),
+        }
+    }
+
+    /// Forgets every contact (at the start of a step).
+    pub(crate) fn clear(&mut self) {
+        for &i in &self.noted {
+            self.count[i as usize] = 0;
+        }
+        self.noted.clear();
+    }
+
+    /// Notes a contact of ball `i` at in-step time `s` and tells what its contacts within
+    /// `tolerance` of the first of them say. A contact further away starts a new instant.
+    pub(crate) fn note(&mut self, i: usize, s: T, tolerance: T) -> Repeat {
+        let count = &mut self.count[i];
+        if *count == 0 {
+            self.noted.push(i as u32);
+        }
+        if *count == 0 || (s - self.anchor[i]).abs() > tolerance {
+            self.anchor[i] = s;
+            *count = 1;
+        } else {
+            *count = count.saturating_add(1);
+        }
+        match *count {
+            c if c > CRUSH_CONTACTS => Repeat::Crushed,
+            c if c > WEDGE_CONTACTS => Repeat::Wedged,
+            _ => Repeat::Free,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ball_is_wedged_then_crushed_after_the_limits_of_contacts_at_one_instant() {
+        let mut r = Repeats::<f64>::new(2);
+        for k in 0..WEDGE_CONTACTS {
+            let s = 0.5 + f64::from(k) * 1e-15;
+            assert_eq!(r.note(0, s, 1e-9), Repeat::Free, "contact {k}");
+        }
+        for k in WEDGE_CONTACTS..CRUSH_CONTACTS {
+            let s = 0.5 + f64::from(k) * 1e-15;
+            assert_eq!(r.note(0, s, 1e-9), Repeat::Wedged, "contact {k}");
+        }
+        assert_eq!(r.note(0, 0.5 + 1e-12, 1e-9), Repeat::Crushed);
+        // The other ball has its own count.
+        assert_eq!(r.note(1, 0.5, 1e-9), Repeat::Free);
+    }
+
+    #[test]
+    fn contacts_at_separate_instants_and_a_new_step_start_afresh() {
+        let mut r = Repeats::<f64>::new(1);
+        // A ball rattling between walls: many contacts, each one instant apart.
+        for k in 0..2 * CRUSH_CONTACTS {
+            assert_eq!(r.note(0, f64::from(k) * 1e-6, 1e-9), Repeat::Free);
+        }
+        for _ in 0..WEDGE_CONTACTS {
+            r.note(0, 0.25, 1e-9);
+        }
+        r.clear();
+        assert_eq!(r.note(0, 0.25, 1e-9), Repeat::Free);
+    }
+}

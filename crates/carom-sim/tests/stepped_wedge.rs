@@ -1,0 +1,284 @@
+//! A free ball wedged between contacts that keep answering each other at one instant
+//! (see the stepped engine's `wedge` module): a heavy ball, spinning from its bounces
+//! off walls that stop it (restitution 0, friction 0.5), overtakes a light ball lying on
+//! a wall and presses it into the wall. Found by fuzzing random scenes; answered one
+//! contact at a time it ran out the event budget (a million contacts) in every step
+//! from 0.23 s on, and the balls froze. A milligram ball squeezed between kilogram balls
+//! on the floor (fuzzed too): one contact at a time passes on a millionth of the push per
+//! contact, and a 2 s run did not end in an hour. And a ball under a kinematic box closing on it:
+//! squeezed out sideways when the box comes at a slant (as in the exact event engine),
+//! an error naming it when the box comes down parallel to the floor (as in the event
+//! engine: no impulse frees it).
+
+mod common;
+
+use carom_geometry::{Border, Obb};
+use carom_integrate::Integrator;
+use carom_math::{Space, Vector};
+use carom_sim::observe::energy;
+use carom_sim::plan::{RunOptions, plan};
+use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
+use carom_sim::{EngineKind, EventEngine, Simulation};
+use carom_toi::Direction;
+use common::{states, stepped};
+use nalgebra::{Const, Vector2, Vector3};
+
+const DT: f64 = 0.01;
+
+/// The walls of a 4 m box centred at the origin, with `restitution`.
+fn walls<const D: usize>(restitution: f64) -> BorderSpec<f64, D>
+where
+    Const<D>: Space<f64, D>,
+{
+    BorderSpec {
+        border: Border::new(Vector::repeat(-2.0), Vector::repeat(2.0)).unwrap(),
+        restitution,
+        periodic: false,
+    }
+}
+
+fn scene() -> Scene<f64, 3> {
+    Scene {
+        world: World {
+            gravity: Vector3::zeros(),
+            restitution: 0.3,
+            friction: 0.5,
+            drag: 0.2,
+            border: Some(walls(0.0)),
+            ..World::default()
+        },
+        balls: vec![
+            BallSpec::new(
+                Vector3::new(
+                    -0.9748243887687595,
+                    -0.7533800743526697,
+                    -1.8131262013297738,
+                ),
+                Vector3::new(-186.4425242296428, 102.53547125595253, 863.3704459699325),
+                0.17006115441852107,
+                1e6,
+            ),
+            BallSpec::new(
+                Vector3::new(1.82536397646231, -0.3897873252987316, -1.622454293431948),
+                Vector3::new(0.5570217173533016, -0.4604488262997146, -0.8257116032956597),
+                0.1,
+                1.0,
+            ),
+        ],
+        ..Scene::default()
+    }
+}
+
+/// Every step: the light ball inside the box and outside the heavy one, the energy never
+/// higher than the step before (no gravity; drag, friction, restitution below 1 and
+/// walls that stop only take it), and the step not cut short by the event budget. The
+/// scene does what it is for: the light ball is driven along the wall at the heavy
+/// ball's pace (from rest to over 10 m/s).
+#[test]
+fn a_ball_pressed_into_a_wall_by_a_spinning_heavy_ball_is_held_without_freezing_or_gaining_energy()
+{
+    let s = scene();
+    let (r_heavy, r_light) = (s.balls[0].radius, s.balls[1].radius);
+    for integrator in Integrator::ALL {
+        let mut sim = stepped(&s, integrator, DT);
+        let mut e_before = energy(&s, &states(&sim));
+        let mut fastest_light = 0.0_f64;
+        for k in 1..=100 {
+            sim.advance_to(f64::from(k) * DT, &mut ()).unwrap();
+            let st = states(&sim);
+            let what = format!("{integrator:?}, step {k}");
+            let e = energy(&s, &st);
+            assert!(
+                e <= e_before * (1.0 + 1e-12),
+                "{what}: energy {e_before} -> {e}"
+            );
+            e_before = e;
+            let gap = (st.pos[1] - st.pos[0]).norm() - r_heavy - r_light;
+            assert!(gap >= -1e-9, "{what}: the balls overlap by {}", -gap);
+            assert!(
+                st.pos[1].amax() <= 2.0 - r_light + 1e-9,
+                "{what}: {:?}",
+                st.pos[1]
+            );
+            fastest_light = fastest_light.max(st.vel[1].norm());
+        }
+        let stats = sim.stats();
+        assert_eq!(stats.capped_steps, 0, "{integrator:?}");
+        assert!(
+            stats.max_contacts_in_step < 1000,
+            "{integrator:?}: {stats:?}"
+        );
+        assert!(fastest_light > 10.0, "{integrator:?}: {fastest_light} m/s");
+    }
+}
+
+/// A ball at rest on the floor of a 4 m box, elastic everywhere, and a plank (2 m by
+/// 0.2 m, centred at the origin) coming down on it at 2 m/s, tilted by `angle`.
+fn plank_over_a_ball(angle: f64) -> Scene<f64, 2> {
+    Scene {
+        world: World {
+            gravity: Vector2::zeros(),
+            restitution: 1.0,
+            border: Some(walls(1.0)),
+            ..World::default()
+        },
+        balls: vec![BallSpec::new(
+            Vector2::new(0.0, -1.8),
+            Vector2::zeros(),
+            0.2,
+            1.0,
+        )],
+        boxes: vec![BoxSpec {
+            shape: Obb::from_angle(Vector2::zeros(), Vector2::new(1.0, 0.1), angle).unwrap(),
+            vel: Vector2::new(0.0, -2.0),
+            restitution: 1.0,
+        }],
+        ..Scene::default()
+    }
+}
+
+/// A plank tilted by 0.1 rad closes on the ball like a wedge and squeezes it out
+/// sideways, faster at each of its bounces: the stepped engine ends where the exact event
+/// engine does (positions within 1e-9 m, the energy the plank gave within 1e-9 of it).
+#[test]
+fn a_slanted_plank_closing_on_a_ball_squeezes_it_out_as_in_the_event_engine() {
+    let s = plank_over_a_ball(0.1);
+    let exact = plan(&s, &RunOptions::default()).unwrap();
+    assert_eq!(exact.engine, EngineKind::Event);
+    let mut event = EventEngine::new(&s, &exact, Direction::Forward).unwrap();
+    event.advance_to(1.5, &mut ()).unwrap();
+    let want = states(&event);
+    for integrator in Integrator::ALL {
+        let mut sim = stepped(&s, integrator, 1.0 / 60.0);
+        sim.advance_to(1.5, &mut ()).unwrap();
+        let got = states(&sim);
+        let apart = (got.pos[0] - want.pos[0]).norm();
+        assert!(
+            apart < 1e-9,
+            "{integrator:?}: {apart} m from the event engine"
+        );
+        let (e, e_exact) = (energy(&s, &got), energy(&s, &want));
+        assert!(e_exact > 100.0, "the plank gave the ball {e_exact} J");
+        assert!(
+            (e - e_exact).abs() < 1e-9 * e_exact,
+            "{integrator:?}: {e} J vs {e_exact} J"
+        );
+    }
+}
+
+/// A plank parallel to the floor leaves the ball no way out when it reaches it, at
+/// 0.75 s (its underside falls 1.5 m at 2 m/s onto the ball's top): the run ends there
+/// with an error naming the ball.
+#[test]
+fn a_plank_coming_down_flat_on_a_ball_ends_the_run_with_an_error_naming_the_crushed_ball() {
+    let s = plank_over_a_ball(0.0);
+    for integrator in Integrator::ALL {
+        let mut sim = stepped(&s, integrator, 1.0 / 60.0);
+        let err = sim.advance_to(2.0, &mut ()).unwrap_err();
+        assert!(
+            (err.time - 0.75).abs() < 1e-9,
+            "{integrator:?}: at {}",
+            err.time
+        );
+        assert!(
+            err.message.contains("balls[0] is crushed"),
+            "{}",
+            err.message
+        );
+        assert_eq!(sim.stats().capped_steps, 0, "{integrator:?}");
+    }
+}
+
+/// Three 1 kg balls and a 1 mg ball falling in a 4 m box (restitution 0 between balls,
+/// 1 at the walls); at 0.73 s the light ball is squeezed on the floor between two heavy
+/// ones. Every step: no overlap, no ball outside the box, no energy gained (gravity and
+/// inelastic contacts only; explicit Euler gains `½ m (g h)²` per step of free flight by
+/// itself, so its energy is not checked), the step not cut short, and at most a few
+/// thousand contacts.
+#[test]
+fn a_milligram_ball_squeezed_between_kilogram_balls_on_the_floor_is_held_at_once() {
+    let ball = |x: f64, y: f64, vx: f64, vy: f64, mass: f64, restitution: Option<f64>| BallSpec {
+        restitution,
+        ..BallSpec::new(Vector2::new(x, y), Vector2::new(vx, vy), 0.05, mass)
+    };
+    let s = Scene {
+        world: World {
+            gravity: Vector2::new(0.0, -9.81),
+            restitution: 0.0,
+            border: Some(walls(1.0)),
+            ..World::default()
+        },
+        balls: vec![
+            ball(
+                -1.18672868723243,
+                0.13235622176199047,
+                0.5699480278862259,
+                0.6881894129377952,
+                1e-6,
+                Some(0.0),
+            ),
+            ball(
+                -0.740548112140532,
+                -1.308272472640592,
+                -0.22621658586253957,
+                -0.04690697288248802,
+                1.0,
+                None,
+            ),
+            ball(
+                -0.6508885686139831,
+                0.5791502681197389,
+                -0.30534407413059217,
+                0.23710949622211874,
+                1.0,
+                None,
+            ),
+            ball(
+                -0.693756680842414,
+                0.4436155652658942,
+                -0.2633790162504597,
+                -0.5478753682986437,
+                1.0,
+                Some(1.0),
+            ),
+        ],
+        ..Scene::default()
+    };
+    for integrator in Integrator::ALL {
+        let mut sim = stepped(&s, integrator, DT);
+        let mut e_before = energy(&s, &states(&sim));
+        for k in 1..=200 {
+            sim.advance_to(f64::from(k) * DT, &mut ()).unwrap();
+            let st = states(&sim);
+            let what = format!("{integrator:?}, step {k}");
+            let e = energy(&s, &st);
+            assert!(
+                integrator == Integrator::ExplicitEuler
+                    || e <= e_before + 1e-9 * e_before.abs().max(1.0),
+                "{what}: energy {e_before} -> {e}"
+            );
+            e_before = e;
+            for a in 0..4 {
+                assert!(
+                    st.pos[a].amax() <= 1.95 + 1e-9,
+                    "{what}: ball {a} at {:?}",
+                    st.pos[a]
+                );
+                for b in a + 1..4 {
+                    let gap = (st.pos[b] - st.pos[a]).norm() - 0.1;
+                    assert!(
+                        gap >= -1e-8,
+                        "{what}: balls {a} and {b} overlap by {}",
+                        -gap
+                    );
+                }
+            }
+        }
+        let stats = sim.stats();
+        assert_eq!(stats.capped_steps, 0, "{integrator:?}");
+        assert!(
+            stats.max_contacts_in_step < 10_000,
+            "{integrator:?}: {stats:?}"
+        );
+    }
+}
