@@ -18,7 +18,8 @@ use carom_math::{Space, Vector};
 use carom_sim::observe::energy;
 use carom_sim::plan::{RunOptions, plan};
 use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
-use carom_sim::{EngineKind, EventEngine, Simulation};
+use carom_sim::stepped::StepStats;
+use carom_sim::{BallStates, EngineKind, EventEngine, Simulation};
 use carom_toi::Direction;
 use common::{states, stepped};
 use nalgebra::{Const, Vector2, Vector3};
@@ -69,40 +70,76 @@ fn scene() -> Scene<f64, 3> {
     }
 }
 
-/// Every step: the light ball inside the box and outside the heavy one, the energy never
-/// higher than the step before (no gravity; drag, friction, restitution below 1 and
-/// walls that stop only take it), and the step not cut short by the event budget. The
-/// scene does what it is for: the light ball is driven along the wall at the heavy
-/// ball's pace (from rest to over 10 m/s).
+/// Runs `s` with `integrator` for `steps` steps of [`DT`], calling `check` after each
+/// with a label for messages, the states and the energies before and after the step;
+/// returns the run's statistics.
+fn run_steps<const D: usize>(
+    s: &Scene<f64, D>,
+    integrator: Integrator,
+    steps: u32,
+    mut check: impl FnMut(&str, &BallStates<f64, D>, f64, f64),
+) -> StepStats
+where
+    Const<D>: Space<f64, D>,
+{
+    let mut sim = stepped(s, integrator, DT);
+    let mut e_before = energy(s, &states(&sim));
+    for k in 1..=steps {
+        sim.advance_to(f64::from(k) * DT, &mut ()).unwrap();
+        let st = states(&sim);
+        let e = energy(s, &st);
+        check(&format!("{integrator:?}, step {k}"), &st, e_before, e);
+        e_before = e;
+    }
+    sim.stats()
+}
+
+/// No two balls of `s` overlapping by more than `tolerance`, every ball inside the
+/// 4 m box of [`walls`] (to 1e-9 m).
+fn assert_apart_and_inside<const D: usize>(
+    s: &Scene<f64, D>,
+    st: &BallStates<f64, D>,
+    what: &str,
+    tolerance: f64,
+) where
+    Const<D>: Space<f64, D>,
+{
+    for (a, ball) in s.balls.iter().enumerate() {
+        let x = st.pos[a];
+        assert!(
+            x.amax() <= 2.0 - ball.radius + 1e-9,
+            "{what}: ball {a} at {x:?}"
+        );
+        for b in a + 1..s.balls.len() {
+            let gap = (st.pos[b] - x).norm() - ball.radius - s.balls[b].radius;
+            assert!(
+                gap >= -tolerance,
+                "{what}: balls {a} and {b} overlap by {}",
+                -gap
+            );
+        }
+    }
+}
+
+/// Every step: the balls inside the box and apart, the energy never higher than the
+/// step before (no gravity; drag, friction, restitution below 1 and walls that stop
+/// only take it), and the step not cut short by the event budget. The scene does what
+/// it is for: the light ball is driven along the wall at the heavy ball's pace (from
+/// rest to over 10 m/s).
 #[test]
 fn a_ball_pressed_into_a_wall_by_a_spinning_heavy_ball_is_held_without_freezing_or_gaining_energy()
 {
     let s = scene();
-    let (r_heavy, r_light) = (s.balls[0].radius, s.balls[1].radius);
     for integrator in Integrator::ALL {
-        let mut sim = stepped(&s, integrator, DT);
-        let mut e_before = energy(&s, &states(&sim));
         let mut fastest_light = 0.0_f64;
-        for k in 1..=100 {
-            sim.advance_to(f64::from(k) * DT, &mut ()).unwrap();
-            let st = states(&sim);
-            let what = format!("{integrator:?}, step {k}");
-            let e = energy(&s, &st);
+        let stats = run_steps(&s, integrator, 100, |what, st, e_before, e| {
             assert!(
                 e <= e_before * (1.0 + 1e-12),
                 "{what}: energy {e_before} -> {e}"
             );
-            e_before = e;
-            let gap = (st.pos[1] - st.pos[0]).norm() - r_heavy - r_light;
-            assert!(gap >= -1e-9, "{what}: the balls overlap by {}", -gap);
-            assert!(
-                st.pos[1].amax() <= 2.0 - r_light + 1e-9,
-                "{what}: {:?}",
-                st.pos[1]
-            );
+            assert_apart_and_inside(&s, st, what, 1e-9);
             fastest_light = fastest_light.max(st.vel[1].norm());
-        }
-        let stats = sim.stats();
+        });
         assert_eq!(stats.capped_steps, 0, "{integrator:?}");
         assert!(
             stats.max_contacts_in_step < 1000,
@@ -245,36 +282,14 @@ fn a_milligram_ball_squeezed_between_kilogram_balls_on_the_floor_is_held_at_once
         ..Scene::default()
     };
     for integrator in Integrator::ALL {
-        let mut sim = stepped(&s, integrator, DT);
-        let mut e_before = energy(&s, &states(&sim));
-        for k in 1..=200 {
-            sim.advance_to(f64::from(k) * DT, &mut ()).unwrap();
-            let st = states(&sim);
-            let what = format!("{integrator:?}, step {k}");
-            let e = energy(&s, &st);
+        let stats = run_steps(&s, integrator, 200, |what, st, e_before, e| {
             assert!(
                 integrator == Integrator::ExplicitEuler
                     || e <= e_before + 1e-9 * e_before.abs().max(1.0),
                 "{what}: energy {e_before} -> {e}"
             );
-            e_before = e;
-            for a in 0..4 {
-                assert!(
-                    st.pos[a].amax() <= 1.95 + 1e-9,
-                    "{what}: ball {a} at {:?}",
-                    st.pos[a]
-                );
-                for b in a + 1..4 {
-                    let gap = (st.pos[b] - st.pos[a]).norm() - 0.1;
-                    assert!(
-                        gap >= -1e-8,
-                        "{what}: balls {a} and {b} overlap by {}",
-                        -gap
-                    );
-                }
-            }
-        }
-        let stats = sim.stats();
+            assert_apart_and_inside(&s, st, what, 1e-8);
+        });
         assert_eq!(stats.capped_steps, 0, "{integrator:?}");
         assert!(
             stats.max_contacts_in_step < 10_000,

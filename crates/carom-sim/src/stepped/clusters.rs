@@ -90,8 +90,6 @@ where
     Const<D>: Space<T, D>,
 {
     pub(crate) list: Vec<StuckCluster<T, D>>,
-    /// The signed linear drag coefficient of the run (negative backward: see `forces`).
-    pub(crate) drag: T,
     /// The smallest side of a periodic border: a cluster may span at most half of it
     /// (see [`Clusters::check_span`]).
     pub(crate) period: Option<T>,
@@ -147,19 +145,45 @@ where
     )
 }
 
-/// The rigid body `rigid` (members at `offsets`) advanced by `tau` from internal time `t`
-/// under the stepper's field and the signed linear `drag` (see the module documentation).
+/// What carries the clusters through the current step: the stepper, the signed linear
+/// drag coefficient of its field (negative backward: see `forces`), the step's length
+/// `h` and the internal time `t0` it started at.
+pub(crate) struct Flight<'a, T: Real, const D: usize, F> {
+    pub(crate) stepper: &'a Stepper<T, D, F>,
+    pub(crate) drag: T,
+    pub(crate) h: T,
+    pub(crate) t0: T,
+}
+
+impl<'a, T: Real, const D: usize, F: ForceField<T, D>> Flight<'a, T, D, F>
+where
+    Const<D>: Space<T, D>,
+{
+    /// The step of length `h` from internal time `t0` under `stepper`.
+    pub(crate) fn new(stepper: &'a Stepper<T, D, F>, h: T, t0: T) -> Self {
+        let drag = (stepper.field().closed_form()).map_or_else(T::zero, |c| c.linear_drag);
+        Self {
+            stepper,
+            drag,
+            h,
+            t0,
+        }
+    }
+}
+
+/// The rigid body `rigid` (members at `offsets`) advanced by `tau` from in-step time `s`
+/// of `flight` under its field and drag (see the module documentation).
 pub(crate) fn advance<T: Real, const D: usize, F: ForceField<T, D>>(
     rigid: &RigidCluster<T, D>,
     offsets: &[Vector<T, D>],
-    stepper: &Stepper<T, D, F>,
-    drag: T,
-    t: T,
+    flight: &Flight<'_, T, D, F>,
+    s: T,
     tau: T,
 ) -> RigidCluster<T, D>
 where
     Const<D>: Space<T, D>,
 {
+    let drag = flight.drag;
     let Ok(dt) = TimeStep::new(tau) else {
         return *rigid;
     };
@@ -167,7 +191,14 @@ where
     let (mut c, mut v) = (rigid.center(), rigid.velocity());
     let mut unused_spin = <Const<D> as Space<T, D>>::angular_zero();
     let drag_share = T::from_count(offsets.len()) / mass;
-    stepper.step_ball(&mut c, &mut v, &mut unused_spin, drag_share, t, dt);
+    (flight.stepper).step_ball(
+        &mut c,
+        &mut v,
+        &mut unused_spin,
+        drag_share,
+        flight.t0 + s,
+        dt,
+    );
     let r0 = rigid.orientation();
     let l0 = rigid.angular_momentum();
     let w0 = rigid.angular_velocity();
@@ -205,8 +236,7 @@ where
         self.push.added(&self.start, T::one())
     }
 
-    /// The rigid state at in-step time `s >= seg_t` of a step of length `h` (that started
-    /// at internal time `t0`): the orientation advanced along the drive, the centre of
+    /// The rigid state at in-step time `s >= seg_t` of `flight`: the orientation advanced along the drive, the centre of
     /// mass on the chord between the segment's ends, the motion interpolated linearly
     /// between the start's and the end's (see the module documentation); and the drive's
     /// motion there less that motion (the push of the rest of the segment).
@@ -220,10 +250,7 @@ where
     fn state_at<F: ForceField<T, D>>(
         &self,
         s: T,
-        h: T,
-        stepper: &Stepper<T, D, F>,
-        drag: T,
-        t0: T,
+        flight: &Flight<'_, T, D, F>,
     ) -> (RigidCluster<T, D>, Motion<T, D>) {
         if s <= self.seg_t {
             return (self.start, self.push);
@@ -231,12 +258,11 @@ where
         let drive = advance(
             &self.drive(),
             &self.offsets,
-            stepper,
-            drag,
-            t0 + self.seg_t,
+            flight,
+            self.seg_t,
             s - self.seg_t,
         );
-        let span = h - self.seg_t;
+        let span = flight.h - self.seg_t;
         if span <= T::zero() {
             return (drive, Motion::zero());
         }
@@ -262,29 +288,22 @@ where
     pub(crate) fn at<F: ForceField<T, D>>(
         &self,
         s: T,
-        h: T,
-        stepper: &Stepper<T, D, F>,
-        drag: T,
-        t0: T,
+        flight: &Flight<'_, T, D, F>,
     ) -> RigidCluster<T, D> {
-        self.state_at(s, h, stepper, drag, t0).0
+        self.state_at(s, flight).0
     }
 
     /// Restarts the segment at `s` on the same motion: it starts from the state there,
     /// the push is what the drive has beyond it, the end is unchanged; the members
     /// restart on their chords. Returns the state at `s`.
-    #[allow(clippy::too_many_arguments)]
     pub(crate) fn restart_at<F: ForceField<T, D>>(
         &mut self,
         balls: &mut BallArrays<T, D>,
         s: T,
-        h: T,
-        stepper: &Stepper<T, D, F>,
-        drag: T,
-        t0: T,
+        flight: &Flight<'_, T, D, F>,
     ) -> RigidCluster<T, D> {
-        let (rigid, push) = self.state_at(s, h, stepper, drag, t0);
-        self.restart_members(balls, &rigid, s, h);
+        let (rigid, push) = self.state_at(s, flight);
+        self.restart_members(balls, &rigid, s, flight.h);
         self.start = rigid;
         self.push = push;
         self.seg_t = s;
@@ -294,45 +313,38 @@ where
     /// Starts a new segment at `s` from the rigid state `rigid` (the state at `s`,
     /// possibly after an impulse): the members restart where their chords are at `s`,
     /// moving at their rigid velocities, and the cluster and its members are integrated
-    /// to the end of the step `h`.
-    #[allow(clippy::too_many_arguments)]
+    /// to the end of the step.
     pub(crate) fn restart_from<F: ForceField<T, D>>(
         &mut self,
         balls: &mut BallArrays<T, D>,
         rigid: RigidCluster<T, D>,
         s: T,
-        h: T,
-        stepper: &Stepper<T, D, F>,
-        drag: T,
-        t0: T,
+        flight: &Flight<'_, T, D, F>,
     ) {
-        self.restart_members(balls, &rigid, s, h);
+        self.restart_members(balls, &rigid, s, flight.h);
         self.start = rigid;
         self.seg_t = s;
-        self.hold(balls, Motion::zero(), h, stepper, drag, t0, T::one());
+        self.hold(balls, Motion::zero(), flight);
     }
 
     /// Holds the segment with the constant force whose push is `push` (see the module
-    /// documentation; `chord_weight` is `w > 0`): the pose follows the drive to the end
-    /// of the step `h`, whose motion has the push `1/w` times; the members' chords follow.
-    #[allow(clippy::too_many_arguments)]
+    /// documentation): the pose follows the drive to the end of the step, whose motion
+    /// has the push `1/w` times (`w` the integrator's chord weight, `w > 0` for a push);
+    /// the members' chords follow.
     pub(crate) fn hold<F: ForceField<T, D>>(
         &mut self,
         balls: &mut BallArrays<T, D>,
         push: Motion<T, D>,
-        h: T,
-        stepper: &Stepper<T, D, F>,
-        drag: T,
-        t0: T,
-        chord_weight: T,
+        flight: &Flight<'_, T, D, F>,
     ) {
         self.push = push;
-        let s = self.seg_t;
-        let end = advance(&self.drive(), &self.offsets, stepper, drag, t0 + s, h - s);
+        let (s, h) = (self.seg_t, flight.h);
+        let end = advance(&self.drive(), &self.offsets, flight, s, h - s);
         self.end = if push == Motion::zero() {
             end
         } else {
-            push.added(&end, T::one() / chord_weight - T::one())
+            let w = T::lit(flight.stepper.integrator().chord_weight());
+            push.added(&end, T::one() / w - T::one())
         };
         self.set_member_ends(balls, h);
     }
@@ -368,12 +380,10 @@ impl<T: Real, const D: usize> Clusters<T, D>
 where
     Const<D>: Space<T, D>,
 {
-    /// No clusters yet, for a run with the signed linear `drag` coefficient, in a periodic
-    /// border whose smallest side is `period`.
-    pub(crate) fn new(drag: T, period: Option<T>) -> Self {
+    /// No clusters yet, for a run in a periodic border whose smallest side is `period`.
+    pub(crate) fn new(period: Option<T>) -> Self {
         Self {
             list: Vec::new(),
-            drag,
             period,
         }
     }
@@ -394,38 +404,28 @@ where
         }
     }
 
-    /// Integrates every cluster over the whole step `h` from internal time `t0` and sets
-    /// its members' segments (after the balls' own integration, which it overrides).
+    /// Integrates every cluster over the whole step of `flight` and sets its members'
+    /// segments (after the balls' own integration, which it overrides).
     pub(crate) fn integrate<F: ForceField<T, D>>(
         &mut self,
         balls: &mut BallArrays<T, D>,
-        stepper: &Stepper<T, D, F>,
-        t0: T,
-        h: T,
+        flight: &Flight<'_, T, D, F>,
     ) {
-        let drag = self.drag;
         for cluster in &mut self.list {
             let rigid = cluster.end;
             cluster.start = rigid;
             cluster.seg_t = T::zero();
             cluster.push = Motion::zero();
-            cluster.end = advance(&rigid, &cluster.offsets, stepper, drag, t0, h);
-            cluster.set_member_ends(balls, h);
+            cluster.end = advance(&rigid, &cluster.offsets, flight, T::zero(), flight.h);
+            cluster.set_member_ends(balls, flight.h);
         }
     }
 
     /// Stops every cluster at in-step time `s` for the rest of the step (velocity and
     /// angular momentum kept), as the event budget does to every ball.
-    pub(crate) fn freeze<F: ForceField<T, D>>(
-        &mut self,
-        s: T,
-        h: T,
-        stepper: &Stepper<T, D, F>,
-        t0: T,
-    ) {
-        let drag = self.drag;
+    pub(crate) fn freeze<F: ForceField<T, D>>(&mut self, s: T, flight: &Flight<'_, T, D, F>) {
         for cluster in &mut self.list {
-            let rigid = cluster.at(s, h, stepper, drag, t0);
+            let rigid = cluster.at(s, flight);
             cluster.start = rigid;
             cluster.push = Motion::zero();
             cluster.seg_t = s;
@@ -435,24 +435,20 @@ where
 
     /// Moves every cluster whose centre of mass at in-step time `s` left the periodic
     /// cell `border` by the period(s) that bring it back, members included.
-    #[allow(clippy::too_many_arguments)]
     pub(crate) fn wrap<F: ForceField<T, D>>(
         &mut self,
         balls: &mut BallArrays<T, D>,
         border: &Border<T, D>,
         s: T,
-        h: T,
-        stepper: &Stepper<T, D, F>,
-        t0: T,
+        flight: &Flight<'_, T, D, F>,
     ) {
-        let drag = self.drag;
         for cluster in &mut self.list {
-            let c = cluster.at(s, h, stepper, drag, t0).center();
+            let c = cluster.at(s, flight).center();
             let shift = border.wrap(&c) - c;
             if shift == Vector::<T, D>::zeros() {
                 continue;
             }
-            let rigid = cluster.restart_at(balls, s, h, stepper, drag, t0);
+            let rigid = cluster.restart_at(balls, s, flight);
             for &m in &cluster.members {
                 balls.seg_x[m as usize] += shift;
                 balls.pos[m as usize] += shift;

@@ -56,14 +56,14 @@ mod sweep;
 mod wedge;
 
 use carom_geometry::{Ball, Border};
-use carom_integrate::{Bodies, ForceField, Integrator, Stepper, TimeStep};
+use carom_integrate::{Bodies, Integrator, Stepper, TimeStep};
 use carom_math::{Real, Space, Vector, ensure_finite_vector};
 use carom_toi::Direction;
 use nalgebra::Const;
 use rayon::prelude::*;
 
 use self::balls::BallArrays;
-use self::clusters::Clusters;
+use self::clusters::{Clusters, Flight};
 use self::forces::WorldForces;
 use self::lcp::Lcp;
 use self::narrow::{Event, Narrow, Overflow, Target};
@@ -235,7 +235,6 @@ where
         };
         let periodic_reach = periodic_reach(scene, periodic.as_ref())?;
         let forces = WorldForces::new(world.gravity, world.drag, direction == Direction::Backward);
-        let drag = forces.closed_form().map_or_else(T::zero, |c| c.linear_drag);
         let stepper = Stepper::new(integrator, forces)
             .map_err(|e| SceneError::new("--integrator", e.to_string()))?;
         let rules = Rules::for_scene(scene, h)?;
@@ -250,7 +249,7 @@ where
             stepper,
             rules,
             rest: RestSets::new(n),
-            clusters: Clusters::new(drag, periodic.as_ref().map(|b| b.extents().min())),
+            clusters: Clusters::new(periodic.as_ref().map(|b| b.extents().min())),
             changed: Vec::new(),
             sweep,
             queue: EventQueue::new(),
@@ -452,8 +451,7 @@ where
                 &mut b.supported,
             );
         }
-        self.clusters
-            .integrate(&mut self.balls, &self.stepper, t0, h);
+        (self.clusters).integrate(&mut self.balls, &Flight::new(&self.stepper, h, t0));
     }
 
     fn narrow(&self, end: T) -> Narrow<'_, T, D> {
@@ -624,7 +622,7 @@ where
     ///
     /// # Errors
     /// A ball of it is crushed.
-    fn wedged(&mut self, e: &Event<T, D>, h: T, t0: T) -> Result<bool, SimError> {
+    fn note_contacts(&mut self, e: &Event<T, D>, h: T, t0: T) -> Result<bool, SimError> {
         let [i, other] = e.balls();
         let instant = h * T::lit(1e-9);
         let mut repeat = self.repeats.note(i, e.time, instant);
@@ -665,7 +663,7 @@ where
         let in_cluster = |b: &BallArrays<T, D>, k: usize| Clusters::of(b, k).is_some();
         let clustered = in_cluster(&self.balls, i) || in_cluster(&self.balls, other);
         let grouped_i = self.groups.grouped(i);
-        let wedged = self.wedged(e, h, t0)?;
+        let wedged = self.note_contacts(e, h, t0)?;
         self.changed.clear();
         let mut contacts = Contacts {
             balls: &mut self.balls,
@@ -832,7 +830,7 @@ where
     /// Stops every ball and cluster at in-step time `s` for the rest of the step
     /// (velocities kept).
     fn freeze(&mut self, s: T, h: T, t0: T) {
-        self.clusters.freeze(s, h, &self.stepper, t0);
+        (self.clusters).freeze(s, &Flight::new(&self.stepper, h, t0));
         let b = &mut self.balls;
         for i in 0..b.len() {
             b.restart(i, s, h);
@@ -933,7 +931,7 @@ where
             return;
         };
         let b = &mut self.balls;
-        self.clusters.wrap(b, &border, s, h, &self.stepper, t0);
+        (self.clusters).wrap(b, &border, s, &Flight::new(&self.stepper, h, t0));
         for i in 0..b.len() {
             if Clusters::of(b, i).is_some() {
                 continue;

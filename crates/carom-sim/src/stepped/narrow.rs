@@ -351,26 +351,22 @@ where
         // which changes no other wall's time (the walls are axis-aligned). Otherwise a
         // ball sliding along one wall would pass through the next.
         let mut u = b.chord[i];
-        let mut toi = ball_border(
-            &ball,
-            &Kinematics::new_unchecked(u, Vector::zeros()),
-            border,
-            &window,
-        );
-        for _ in 1..D {
-            if toi.status != Status::AlreadyTouching
-                || !self.not_approaching(&u, &Vector::zeros(), &toi.normal)
-            {
-                break;
-            }
-            u -= toi.normal * u.dot(&toi.normal);
-            toi = ball_border(
+        let mut asked = 0;
+        let toi = loop {
+            let toi = ball_border(
                 &ball,
                 &Kinematics::new_unchecked(u, Vector::zeros()),
                 border,
                 &window,
             );
-        }
+            asked += 1;
+            let sliding = toi.status == Status::AlreadyTouching
+                && self.not_approaching(&u, &Vector::zeros(), &toi.normal);
+            if !sliding || asked == D {
+                break toi;
+            }
+            u -= toi.normal * u.dot(&toi.normal);
+        };
         self.event(
             &toi,
             s,

@@ -44,7 +44,7 @@ use carom_response::{Body, Coefficients, Contact, Response, normal_velocity, res
 use nalgebra::Const;
 
 use super::balls::BallArrays;
-use super::clusters::Clusters;
+use super::clusters::{Clusters, Flight};
 use super::lcp::Lcp;
 use super::obstacles::BoxArrays;
 use super::rest::{RestSet, Support, Touch};
@@ -220,10 +220,15 @@ where
     pub(crate) t0: T,
 }
 
-impl<T: Real, const D: usize, F: ForceField<T, D>> Contacts<'_, T, D, F>
+impl<'a, T: Real, const D: usize, F: ForceField<T, D>> Contacts<'a, T, D, F>
 where
     Const<D>: Space<T, D>,
 {
+    /// The step the contacts are in, for the clusters.
+    pub(super) fn flight(&self) -> Flight<'a, T, D, F> {
+        Flight::new(self.stepper, self.h, self.t0)
+    }
+
     pub(super) fn body(&self, i: usize, v: Vector<T, D>, w: Angular<T, D>) -> Body<T, D> {
         let b = &*self.balls;
         Body::new_unchecked(

@@ -1059,7 +1059,7 @@ where
     /// segment start.
     fn push(&mut self, stack: &Stack<T, D>, changes: &Changes<T, D>) {
         let w = T::lit(self.stepper.integrator().chord_weight());
-        let drag = self.clusters.drag;
+        let flight = self.flight();
         let (start_share, end_share) = if w > T::zero() {
             (T::zero(), T::one() / w)
         } else {
@@ -1086,15 +1086,7 @@ where
                         momentum: *angular,
                     };
                     if w > T::zero() {
-                        self.clusters.list[c].hold(
-                            self.balls,
-                            push,
-                            self.h,
-                            self.stepper,
-                            drag,
-                            self.t0,
-                            w,
-                        );
+                        self.clusters.list[c].hold(self.balls, push, &flight);
                     } else {
                         self.finish_cluster(c, push.added(&start, T::one()));
                     }

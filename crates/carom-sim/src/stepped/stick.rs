@@ -54,17 +54,17 @@ where
     /// Restarts cluster `c`'s segment at `s` (members on their chords, the motion and the
     /// end of the step unchanged) and returns its rigid state there.
     pub(super) fn begin_cluster(&mut self, c: usize, s: T) -> RigidCluster<T, D> {
-        let drag = self.clusters.drag;
-        self.clusters.list[c].restart_at(self.balls, s, self.h, self.stepper, drag, self.t0)
+        let flight = self.flight();
+        self.clusters.list[c].restart_at(self.balls, s, &flight)
     }
 
     /// Cluster `c` continues from `rigid` at its segment start: the rest of the step is
     /// integrated again and the members' chords follow.
     pub(super) fn finish_cluster(&mut self, c: usize, rigid: RigidCluster<T, D>) {
-        let drag = self.clusters.drag;
+        let flight = self.flight();
         let cluster = &mut self.clusters.list[c];
         let s = cluster.seg_t;
-        cluster.restart_from(self.balls, rigid, s, self.h, self.stepper, drag, self.t0);
+        cluster.restart_from(self.balls, rigid, s, &flight);
         for &m in &cluster.members {
             self.balls.supported[m as usize] = false;
         }
