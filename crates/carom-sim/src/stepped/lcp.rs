@@ -67,9 +67,16 @@ pub(crate) struct Lcp<T: Real> {
     forward: Vec<T>,
     /// The row of the factor whose pivot failed in the last [`Self::solve_passive`].
     dependent: Option<usize>,
+    /// The largest problem solved so far (its number of contacts).
+    largest: usize,
 }
 
 impl<T: Real> Lcp<T> {
+    /// The most contacts of any problem solved so far.
+    pub(crate) fn largest(&self) -> usize {
+        self.largest
+    }
+
     /// Solves `w = A λ + q >= 0, λ >= 0, λ·w = 0` for the `n × n` matrix `a` (row-major,
     /// symmetric positive semi-definite, positive diagonal) into `lambda` (length `n`).
     /// A contact counts as closing when its margin is below `−tolerance` (the speed below
@@ -78,6 +85,7 @@ impl<T: Real> Lcp<T> {
     /// impulses are still the best the independent ones give).
     pub(crate) fn solve(&mut self, a: &[T], q: &[T], tolerance: T, lambda: &mut [T]) -> bool {
         let n = q.len();
+        self.largest = self.largest.max(n);
         debug_assert_eq!(a.len(), n * n);
         debug_assert_eq!(lambda.len(), n);
         self.scale.clear();

@@ -107,6 +107,9 @@ pub struct StepStats {
     pub rebuilds: u64,
     /// The most contacts any single step needed.
     pub max_contacts_in_step: u64,
+    /// The most contacts held together in one complementarity problem (a stack's hold,
+    /// see `docs/stepped.md`): its cost grows with the cube of this.
+    pub largest_hold: u64,
     /// Steps that exhausted the event budget (see [`SteppedEngine::set_event_budget`]).
     pub capped_steps: u64,
     /// The simulated time those steps spent frozen (s).
@@ -328,6 +331,7 @@ where
     pub fn stats(&self) -> StepStats {
         StepStats {
             broad_builds: self.sweep.builds(),
+            largest_hold: self.lcp.largest() as u64,
             ..self.stats
         }
     }

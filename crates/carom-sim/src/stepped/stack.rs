@@ -10,9 +10,12 @@
 //! `response`); walls and boxes are surfaces. A free ball takes part only with its walls,
 //! boxes and held balls below: its contacts with other free balls are the balls' own
 //! events, except in the hold of a wedged ball ([`Approach::Any`], see `wedge`), which
-//! takes in the free balls touching it, and theirs, with every approaching contact
-//! (answered one at a time, a 1 mg ball squeezed between two 1 kg balls and a floor
-//! passes on a millionth of the push per contact). Every body of the stack restarts at the contact's instant `s` free of earlier
+//! takes in the free balls touching it, and theirs, with every touching contact however
+//! fast it approaches (answered one at a time, a 1 mg ball squeezed between two 1 kg
+//! balls and a floor passes on a millionth of the push per contact). A free ball that
+//! only closes on them within the step stays out, its contact a collision of its own: a
+//! ball at 1e6 m/s closes on every ball it can reach, and took whole scenes into one
+//! hold. Every body of the stack restarts at the contact's instant `s` free of earlier
 //! holds of the step (see `clusters`: its physical state there, the force dropped), and
 //! the stack's contacts are solved in two phases:
 //!
@@ -293,8 +296,8 @@ pub(crate) enum Approach {
     /// Those no faster than support (and the seed): faster ones are collisions, each
     /// answered by its own event with its restitution.
     Slow,
-    /// All: the stack's balls are wedged (see `wedge`), and answering its contacts one at
-    /// a time would not end.
+    /// All that touch (and the slow ones closing within the step): the stack's balls
+    /// are wedged (see `wedge`), and answering its contacts one at a time would not end.
     Any,
 }
 
@@ -434,12 +437,15 @@ where
         // A contact approaching faster than support is a collision, its own event: left
         // out, unless it is the contact the hold is for (whose collision has been
         // answered: what it left closing, a cluster turning into a floor it struck, is
-        // stopped here).
-        let fast: Vec<bool> = (stack.rows.iter().zip(&start))
-            .map(|(row, u)| {
-                stack.approach == Approach::Slow
-                    && u.dot(&row.normal) > self.rules.support_speed
-                    && !seed.is(row)
+        // stopped here), or it touches in a wedge's hold (whose contacts answer each other
+        // at one instant).
+        let fast: Vec<bool> = (stack.rows.iter().zip(&start).enumerate())
+            .map(|(c, (row, u))| {
+                let skip = match stack.approach {
+                    Approach::Slow => !seed.is(row),
+                    Approach::Any => row.gap > tolerance(c),
+                };
+                skip && u.dot(&row.normal) > self.rules.support_speed
             })
             .collect();
         // 1. Impacts: restitution 0 on the velocities at s, touching contacts only.
@@ -816,7 +822,12 @@ where
                     });
                     continue;
                 }
-                (None, Side::Ball(_)) if !cluster_body && stack.approach == Approach::Slow => {
+                // A free ball enters only a wedge's hold, and only touching: one closing
+                // within the step is a collision of its own (a ball at 1e6 m/s closes on
+                // every ball it could reach in the step).
+                (None, Side::Ball(_))
+                    if !cluster_body && (stack.approach == Approach::Slow || gap > tolerance) =>
+                {
                     continue;
                 }
                 (None, _) => self.enter(stack, side, s),

@@ -30,8 +30,8 @@ use carom_math::Real;
 /// far fewer: a column of `k` balls settles in `k(k+1)/2` contacts, `k` for each ball.
 pub(crate) const WEDGE_CONTACTS: u32 = 256;
 
-/// Contacts of one ball at one instant beyond which it is crushed: four times the wedge
-/// limit, so that a wedge is held several times first.
+/// Contacts of one ball at one instant beyond which it is crushed: 64 times the wedge
+/// limit, so that a wedge is held many times first.
 pub(crate) const CRUSH_CONTACTS: u32 = 64 * WEDGE_CONTACTS;
 
 /// What a ball's contacts at one instant say about it.
