@@ -309,7 +309,7 @@ fn a_milligram_ball_squeezed_between_kilogram_balls_on_the_floor_is_held_at_once
 /// and no hold of more than a few contacts.
 #[test]
 fn a_wedged_ball_is_held_with_the_balls_touching_it_not_with_every_fast_ball_closing_on_it() {
-    let text = r#"
+    let text = r"
 dim = 2
 balls = [
     { pos = [-0.27317388501575235, -0.5635518518230997], vel = [0.9422898861428126, 0.3783666790887559], radius = 0.05433076056972105, mass = 1.0 },
@@ -333,7 +333,7 @@ friction = 0.5
 min = [-2.0, -2.0]
 max = [2.0, 2.0]
 restitution = 1.0
-"#;
+";
     let LoadedScene::D2(s) = parse_scene(text).unwrap() else {
         panic!("a 2D scene");
     };
