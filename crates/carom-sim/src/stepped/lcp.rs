@@ -32,7 +32,7 @@
 //! members of a flat cluster on the floor in 2D; a 3D cluster resting in three pockets,
 //! nine contacts on six degrees of freedom): their impulses are not unique, the
 //! velocities are. A contact whose Cholesky pivot on the unit-diagonal matrix falls below
-//! [`DEPENDENT`] depends on the passive ones to rounding, so it never joins them as it
+//! [`DEPENDENT`] roundings depends on the passive ones to rounding, so it never joins them as it
 //! is: pushing on it moves nothing they do not. If it closes, it *trades places* with one
 //! of them: its row is `Σ c_k` times theirs, so raising its impulse by `τ` while lowering
 //! theirs by `τ c_k` changes no velocity and lowers the objective by `τ |w|`; the largest
@@ -48,11 +48,16 @@
 
 use carom_math::Real;
 
-/// A Cholesky pivot (squared) below this, on the unit-diagonal scaled matrix, marks a
-/// contact as dependent on the passive ones (see the module documentation): its row is a combination of theirs to about
-/// `√DEPENDENT ≈ 3e-6` relative. Exact dependence leaves rounding (~1e-16); a mass ratio
-/// of 10⁶ between two bodies in contact leaves pivots of about 10⁻⁶, independent.
-pub(crate) const DEPENDENT: f64 = 1e-11;
+/// A Cholesky pivot (squared) below `DEPENDENT` roundings (`T::EPSILON`), on the
+/// unit-diagonal scaled matrix, marks a contact as dependent on the passive ones (see the
+/// module documentation). Exact dependence leaves a few roundings (~1e-16 in `f64`); a
+/// mass ratio `r` between the bodies of two contacts leaves pivots of about `1/r`: in
+/// `f64` (threshold 2.3e-13) independent up to `r` ≈ 4e12, which covers the scene
+/// contract's 1e-6 kg ball pressed into a wall by a 1e6 kg ball (`r` = 1e12: a fixed
+/// threshold of 1e-11 called its two contacts dependent, left the wall's contact
+/// closing, and the ball was held again at the same instant until the crush limit); in
+/// `f32` (1.2e-4) up to about 8e3, as far as its roundings resolve.
+pub(crate) const DEPENDENT: f64 = 1024.0;
 
 /// Scratch of [`solve`], kept between calls.
 #[derive(Clone, Debug, Default)]
@@ -252,7 +257,7 @@ impl<T: Real> Lcp<T> {
                     sum -= self.factor[r * p + k] * self.factor[c * p + k];
                 }
                 if r == c {
-                    if sum <= T::lit(DEPENDENT) {
+                    if sum <= T::lit(DEPENDENT) * T::EPSILON {
                         self.dependent = Some(r);
                         return false;
                     }
@@ -302,6 +307,29 @@ mod tests {
 
         fn next(&mut self) -> f64 {
             self.0.range(-1.0, 1.0)
+        }
+    }
+
+    /// A 1 mg ball between a wall and a 1,000 t ball closing on it at 979 m/s (a mass
+    /// ratio of 1e12, as in a fuzzed scene): both contacts push, each with the closed-form
+    /// impulse `979 m_H` (the wall's margin is the light ball's speed `λ₁ − λ₂` over its
+    /// mass, zero; the heavy ball stops, `λ₂ = 979 m_H`). With a fixed dependence
+    /// threshold of 1e-11 the wall's contact (pivot 1e-12) counted as dependent and was
+    /// left closing.
+    #[test]
+    fn a_milligram_ball_pressed_into_a_wall_by_a_thousand_tonne_ball_is_held_by_both_contacts() {
+        let (light, heavy) = (1e-6_f64, 1e6_f64);
+        let a = [
+            1.0 / light,
+            -1.0 / light,
+            -1.0 / light,
+            1.0 / light + 1.0 / heavy,
+        ];
+        let q = [0.0, -979.0];
+        let mut lambda = [0.0; 2];
+        Lcp::default().solve(&a, &q, 1e-9, &mut lambda);
+        for l in lambda {
+            assert!((l / (979.0 * heavy) - 1.0).abs() < 1e-3, "{lambda:?}");
         }
     }
 
