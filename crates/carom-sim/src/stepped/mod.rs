@@ -1031,12 +1031,13 @@ where
         SimError {
             time: self.time().to_f64(),
             message: format!(
-                "a stuck cluster of {} balls ({}{more}) spins at {:e} rad/s: it would turn {:e} rad in the step, more than the {limit} rad the stepped engine follows in one ({MAX_SUBSTEPS} sub-steps of {MAX_TURN} rad); use a --dt below {:e} s",
+                "a stuck cluster of {} balls ({}{more}) spins at {:e} rad/s: it would turn {:e} rad in the step, more than the {limit} rad the stepped engine follows in one step ({MAX_SUBSTEPS} sub-steps of at most {MAX_TURN} rad); use a --dt below {:e} s (below {:e} s it needs no sub-steps)",
                 members.len(),
                 named.join(", "),
                 spin.to_f64(),
                 (spin * rest).to_f64(),
-                limit / spin.to_f64()
+                limit / spin.to_f64(),
+                MAX_TURN / spin.to_f64()
             ),
         }
     }
