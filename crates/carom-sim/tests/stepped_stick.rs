@@ -1038,28 +1038,21 @@ fn a_cluster_spinning_too_fast_for_the_step_ends_the_run_naming_it_and_the_step_
             m.contains("stuck cluster of 2 balls (balls[0], balls[1])") && m.contains("--dt below"),
             "{integrator}: {m}"
         );
-        let spin: f64 = m
-            .split(" spins at ")
-            .nth(1)
-            .unwrap()
-            .split(' ')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap();
+        let spin = number_after(m, " spins at ");
         assert!((1e7..1e8).contains(&spin), "{integrator}: {m}");
-        let dt: f64 = m
-            .split("--dt below ")
-            .nth(1)
-            .unwrap()
-            .split(' ')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap();
+        let dt = number_after(m, "--dt below ");
         assert!(
             (dt * spin - 819.2).abs() < 1e-6 * 819.2,
             "{integrator}: {m}"
         );
     }
+}
+
+/// The number that follows the first `key` in `message`, up to the next space.
+fn number_after(message: &str, key: &str) -> f64 {
+    let rest = message
+        .split(key)
+        .nth(1)
+        .unwrap_or_else(|| panic!("{key:?} in {message}"));
+    rest.split(' ').next().unwrap().parse().unwrap()
 }
