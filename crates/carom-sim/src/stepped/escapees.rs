@@ -17,8 +17,8 @@
 //! `MAX_LANES_PER_BOX + 1` times however often it changes: filing every change anew let
 //! a ball at 1e6 m/s, whose box changes at each of its thousands of wall bounces in a
 //! step, file itself thousands of times in the wide list that every lookup scans (a
-//! 40-ball scene spent 220 µs per contact by its 30,000th contact, and over 100 s on its
-//! first step).
+//! 40-ball scene averaged 220 µs per contact over its first 30,000 contacts, 12 µs over
+//! its first 1,000, and took over 100 s for its first step).
 
 use carom_geometry::Aabb;
 use carom_math::Real;

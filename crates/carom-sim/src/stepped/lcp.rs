@@ -13,7 +13,7 @@
 //! matrix), `q` each contact's margin before any impulse (the speed it may still close
 //! at, less the speed it closes at) and `w` its margin after. These are the optimality
 //! conditions of the convex programme `min ½ λᵀAλ + qᵀλ` over `λ >= 0`, which
-//! [`solve`] solves by an active-set method: Lawson and Hanson's non-negative least
+//! [`Lcp::solve`] solves by an active-set method: Lawson and Hanson's non-negative least
 //! squares in its normal-equations form (*Solving Least Squares Problems*, 1974, ch. 23).
 //! The passive set `P` (the contacts that push) grows by the contact with the most
 //! negative margin; on `P` the margins are zero, `A_PP λ_P = −q_P` (a Cholesky solve); a
@@ -32,8 +32,8 @@
 //! members of a flat cluster on the floor in 2D; a 3D cluster resting in three pockets,
 //! nine contacts on six degrees of freedom): their impulses are not unique, the
 //! velocities are. A contact whose Cholesky pivot on the unit-diagonal matrix falls below
-//! [`DEPENDENT`] roundings depends on the passive ones to rounding, so it never joins them as it
-//! is: pushing on it moves nothing they do not. If it closes, it *trades places* with one
+//! [`dependence_threshold`] depends on the passive ones to rounding, so it never joins
+//! them as it is: pushing on it moves nothing they do not. If it closes, it *trades places* with one
 //! of them: its row is `Σ c_k` times theirs, so raising its impulse by `τ` while lowering
 //! theirs by `τ c_k` changes no velocity and lowers the objective by `τ |w|`; the largest
 //! `τ` that keeps the impulses non-negative brings one with `c_k > 0` to zero, which
@@ -57,17 +57,23 @@ use carom_math::Real;
 /// ball pressed into a wall by a 1e6 kg ball (`r` = 1e12: a threshold of 1e-11 called
 /// its two contacts dependent, left the wall's contact closing, and the ball was held
 /// again at the same instant until the crush limit).
-pub(crate) const DEPENDENT: f64 = 1024.0;
+const DEPENDENT: f64 = 1024.0;
 
 /// The threshold of [`DEPENDENT`] where the precision's roundings are coarser (`f32`):
 /// there a pivot cannot tell dependence (rounding, ~1e-7) from a mass ratio above 1e4,
 /// and treating a dependent contact as independent costs only a poorly conditioned
 /// solve, while treating a mass ratio as dependence leaves a contact closing (measured:
 /// with 1024 roundings, 1.2e-4, five fuzzed `f32` scenes with masses 1e-6 to 1e6 ended
-/// in crush errors within their first steps).
-pub(crate) const DEPENDENT_FLOOR: f64 = 1e-11;
+/// in crush errors within their first two steps).
+const DEPENDENT_FLOOR: f64 = 1e-11;
 
-/// Scratch of [`solve`], kept between calls.
+/// The pivot below which a contact is dependent in precision `T`: [`DEPENDENT`]
+/// roundings, at most [`DEPENDENT_FLOOR`].
+fn dependence_threshold<T: Real>() -> T {
+    (T::lit(DEPENDENT) * T::EPSILON).min(T::lit(DEPENDENT_FLOOR))
+}
+
+/// Scratch of [`Lcp::solve`], kept between calls.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Lcp<T: Real> {
     scale: Vec<T>,
@@ -265,7 +271,7 @@ impl<T: Real> Lcp<T> {
                     sum -= self.factor[r * p + k] * self.factor[c * p + k];
                 }
                 if r == c {
-                    if sum <= (T::lit(DEPENDENT) * T::EPSILON).min(T::lit(DEPENDENT_FLOOR)) {
+                    if sum <= dependence_threshold::<T>() {
                         self.dependent = Some(r);
                         return false;
                     }
@@ -335,6 +341,8 @@ mod tests {
         ];
         let q = [0.0, -979.0];
         let mut lambda = [0.0; 2];
+        // Its return is not asked: the margins are differences of terms of 1e15 m/s
+        // (`λ / m_L`), whose rounding (~0.2 m/s) is above any tolerance of a speed.
         Lcp::default().solve(&a, &q, 1e-9, &mut lambda);
         for l in lambda {
             assert!((l / (979.0 * heavy) - 1.0).abs() < 1e-3, "{lambda:?}");

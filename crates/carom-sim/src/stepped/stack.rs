@@ -374,7 +374,7 @@ where
     Const<D>: Space<T, D>,
 {
     /// Free ball `i`, wedged at in-step time `s` (see `wedge`), touching `other`: the stack
-    /// around the contact held with every approaching contact taken in.
+    /// around the contact held with every touching contact taken in ([`Approach::Any`]).
     pub(crate) fn wedged(&mut self, i: usize, other: SeedOther<T, D>, s: T) -> Effect {
         if s < self.h {
             self.hold_stack(Seed { ball: i, other }, s, Approach::Any);
