@@ -248,3 +248,39 @@ fn a_ball_rides_a_rising_platform() {
         assert!(rec.collisions.is_empty());
     }
 }
+
+/// Two equal balls side by side on the floor, elastic, the left one sliding into the
+/// resting right one at 0.01 m/s (slower than gravity adds in a step: a support-sized
+/// contact). Neither holds the other up, however their heights differ by the rounding
+/// of resting on one floor: the right one 1e-10 m lower, level, or 1e-10 m higher, the
+/// velocities are exchanged (closed form for an elastic collision of equal masses). With
+/// the right ball lower by rounding it was taken for a support under the left one, which
+/// stopped dead and lost its energy.
+#[test]
+fn a_slow_ball_passes_its_momentum_to_one_beside_it_whatever_the_rounding_of_their_heights() {
+    let (r, v) = (0.1, 0.01);
+    for offset in [-1e-10, 0.0, 1e-10] {
+        let s = Scene {
+            world: floor_world(1.0, 0.0, 2.0),
+            balls: vec![
+                BallSpec::new(Vector2::new(-0.3, r), Vector2::new(v, 0.0), r, 1.0),
+                BallSpec::new(Vector2::new(0.0, r + offset), Vector2::zeros(), r, 1.0),
+            ],
+            ..Scene::default()
+        };
+        for integrator in Integrator::ALL {
+            let mut sim = stepped(&s, integrator, 1.0 / 100.0);
+            sim.advance_to(20.0, &mut ()).unwrap();
+            let st = states(&sim);
+            let what = format!("{integrator}, right ball {offset} m lower");
+            assert!(st.vel[0].x.abs() < 1e-12, "{what}: {:?}", st.vel);
+            assert!((st.vel[1].x - v).abs() < 1e-12, "{what}: {:?}", st.vel);
+            // The gap of 0.1 m closes at 10 s; the right ball then moves on for 10 s.
+            assert!(
+                (st.pos[1].x - v * 10.0).abs() < 1e-9,
+                "{what}: {:?}",
+                st.pos
+            );
+        }
+    }
+}

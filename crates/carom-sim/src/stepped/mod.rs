@@ -69,7 +69,7 @@ use self::lcp::Lcp;
 use self::narrow::{Event, Narrow, Overflow, Target};
 use self::obstacles::BoxArrays;
 use self::queue::EventQueue;
-use self::response::{Contacts, Effect, RestSets, Rules, Surface};
+use self::response::{Contacts, Effect, RestSets, Rules, Surface, touch_tolerance};
 use self::rest::{Support, Touch};
 use self::stack::{Groups, SeedOther};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
@@ -772,7 +772,7 @@ where
     fn gather(&mut self, i: usize, s: T, out: &mut Vec<Touch<T, D>>) {
         let b = &self.balls;
         let (x, r) = (b.position_at(i, s), b.radius[i]);
-        let tolerance = T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (x.amax() + r);
+        let tolerance = touch_tolerance(&x, r);
         if let Some(border) = &self.border {
             let gaps = border.wall_gaps(&Ball::new_unchecked(x, r));
             for (axis, (below, above)) in gaps.into_iter().enumerate() {
@@ -796,7 +796,6 @@ where
         // Ascending, each once: the supports come in index order whatever the source.
         candidates.sort_unstable();
         candidates.dedup();
-        let g = self.rules.gravity;
         let boxes = if self.sweep.boxes_inside() {
             None
         } else {
@@ -831,8 +830,12 @@ where
                 continue;
             }
             let normal = (y - x) / d;
-            // Below the ball, and not moving up into it (within rounding): it can hold it.
-            if g.dot(&normal) > T::zero() && b.chord[j].dot(&normal) >= -self.rules.floor {
+            // Below the ball (not beside it on a common floor), and not moving up into it
+            // (within rounding): it can hold it.
+            let level = tolerance + touch_tolerance(&y, b.radius[j]);
+            if self.rules.lies_below(&(y - x), level)
+                && b.chord[j].dot(&normal) >= -self.rules.floor
+            {
                 out.push(Touch {
                     support: Support::Ball(j as u32),
                     normal,

@@ -73,6 +73,10 @@ pub(crate) struct Rules<T: Real, const D: usize> {
     /// what gravity adds in a step plus `64 ε` times the scene's speed scale (the fastest
     /// ball or box at the start).
     pub(crate) floor: T,
+    /// `2 floor h`: how much more than their touching tolerances two balls resting on
+    /// one floor may differ in height (what the resting corrections leave, a resting
+    /// ball sinking by up to `floor` over a step); see [`Self::lies_below`].
+    pub(crate) level: T,
     /// `inelastic = "stick"`: two balls whose pair restitution is 0 fuse (see `stick`).
     pub(crate) stick: bool,
 }
@@ -97,6 +101,7 @@ impl<T: Real, const D: usize> Rules<T, D> {
             .fold(g * h, T::max);
         let collapse_speed = (g * h).max(T::lit(1e-6) * speed).max(T::MIN_POSITIVE);
         let bad_step = |e: carom_math::InvalidValue| SceneError::new("--dt", e.to_string());
+        let floor = T::lit(1e-6) * g * h + T::lit(64.0) * T::EPSILON * speed;
         Ok(Self {
             friction: world.friction,
             border_restitution: world.border.as_ref().map_or_else(T::one, |b| b.restitution),
@@ -104,10 +109,29 @@ impl<T: Real, const D: usize> Rules<T, D> {
             resting: RestingGuard::new(T::lit(2.0) * h).map_err(bad_step)?,
             collapse: CollapseGuard::elastic_below(collapse_speed).map_err(bad_step)?,
             support_speed: T::lit(2.0) * g * h,
-            floor: T::lit(1e-6) * g * h + T::lit(64.0) * T::EPSILON * speed,
+            floor,
+            level: T::lit(2.0) * floor * h,
             stick: world.inelastic == Inelastic::Stick,
         })
     }
+
+    /// Whether a ball whose centre lies at `offset` from another's lies below it along
+    /// gravity, so that it can hold it up (shock propagation): lower by more than two
+    /// balls resting on one floor can differ in height, their touching tolerances
+    /// `tolerance` (both summed, see [`touch_tolerance`]) and [`Self::level`]. Two balls
+    /// side by side on a floor hold each other up neither way: taking the one that had
+    /// sunk 3e-10 m deeper for an immovable support stopped a ball rolling slowly into it
+    /// dead (its momentum and energy lost), and a ball a kinematic box pushed into it
+    /// could not give way (a false crush, found by random scenes).
+    pub(crate) fn lies_below(&self, offset: &Vector<T, D>, tolerance: T) -> bool {
+        self.gravity.dot(offset) > self.gravity.norm() * (tolerance + self.level)
+    }
+}
+
+/// The gap within which a ball of radius `r` at `x` touches a surface or a ball: a
+/// billionth of its radius plus the rounding of its coordinates.
+pub(crate) fn touch_tolerance<T: Real, const D: usize>(x: &Vector<T, D>, r: T) -> T {
+    T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (x.amax() + r)
 }
 
 /// What a processed contact did.
@@ -291,14 +315,9 @@ where
         let nominal = b.restitution[i].min(b.restitution[j]);
         let (approach, r) = self.pair_collision(&bi, &bj, &contact, nominal);
         let slow = approach <= self.rules.support_speed;
-        let down = self.rules.gravity.dot(&n);
-        // Ball j holds ball i (or i holds j): it is supported, lies below along gravity
-        // and does not move towards the other (n points from i to j).
-        let floor = self.rules.floor;
-        let j_holds = b.supported[j] && down > T::zero() && b.chord[j].dot(&n) >= -floor;
-        let i_holds = b.supported[i] && down < T::zero() && b.chord[i].dot(&n) <= floor;
-        // A slow contact onto a support is resting: no impulse, only the correction below.
-        let onto_support = slow && (j_holds || i_holds);
+        // A slow contact onto a support (a ball holding the other up, see `holds_up`) is
+        // resting: no impulse, only the correction below.
+        let onto_support = slow && (self.holds_up(i, j, s) || self.holds_up(j, i, s));
         let effect = Effect {
             collided: r.applied() && !slow,
         };
@@ -322,11 +341,9 @@ where
         }
         // Shock propagation: a ball resting on a supported ball below it, that does not
         // move towards it, is held as by an immovable surface, and is supported in turn.
-        let j_holds = b.supported[j] && down > T::zero() && b.chord[j].dot(&n) >= -floor;
-        let i_holds = b.supported[i] && down < T::zero() && b.chord[i].dot(&n) <= floor;
-        if j_holds {
+        if self.holds_up(i, j, s) {
             self.rest_on(i, Support::Ball(j as u32), &n, b.chord[j], b.seg_w[j], s);
-        } else if i_holds {
+        } else if self.holds_up(j, i, s) {
             self.rest_on(j, Support::Ball(i as u32), &-n, b.chord[i], b.seg_w[i], s);
         } else {
             // Two free balls closing along their chords: a perfectly inelastic correction

@@ -66,7 +66,7 @@ use nalgebra::Const;
 use carom_response::RigidCluster;
 
 use super::clusters::{FREE, Motion};
-use super::response::{Contacts, Effect};
+use super::response::{Contacts, Effect, touch_tolerance};
 use super::stick::Side;
 use super::sweep::path_box;
 use crate::engine::Angular;
@@ -427,9 +427,7 @@ where
         let tolerance = |c: usize| {
             let row = &stack.rows[c];
             let r = b.radius[row.end.ball];
-            T::lit(1e-9) * r
-                + T::lit(16.0) * T::EPSILON * (b.seg_x[row.end.ball].amax() + r)
-                + reach
+            touch_tolerance(&b.seg_x[row.end.ball], r) + reach
         };
         let start: Vec<_> = (0..stack.rows.len())
             .map(|c| self.relative(&stack, c, Phase::Start))
@@ -764,7 +762,7 @@ where
             let b = &*self.balls;
             (b.position_at(x, s), b.radius[x], b.chord[x])
         };
-        let tolerance = T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (p.amax() + r);
+        let tolerance = touch_tolerance(&p, r);
         let near = |gap: T, closing: T| gap <= tolerance || closing * rest > gap;
         let centre = stack.parts[k].centre;
         let end = |n: &Vector<T, D>| End {
@@ -851,18 +849,20 @@ where
     }
 
     /// Whether free ball `j` holds ball `x` up at `s` as an immovable surface moving at its
-    /// chord: it lies below `x` along gravity, is held in this step and does not move up
-    /// into it (shock propagation).
-    fn holds_up(&self, x: usize, j: usize, s: T) -> bool {
+    /// chord: it lies below `x` along gravity (not side by side, see
+    /// [`Rules::lies_below`](super::response::Rules::lies_below)), is held in this step and does not move up into it (shock
+    /// propagation).
+    pub(super) fn holds_up(&self, x: usize, j: usize, s: T) -> bool {
         let b = &*self.balls;
         let (p, y) = (b.position_at(x, s), b.position_at(j, s));
         let y = self
             .periodic
             .map_or(y, |border| p + border.minimum_image(&(y - p)));
         let n = y - p;
+        let level = touch_tolerance(&p, b.radius[x]) + touch_tolerance(&y, b.radius[j]);
         x != j
-            && self.rules.gravity.dot(&n) > T::zero()
             && b.supported[j]
+            && self.rules.lies_below(&n, level)
             && b.chord[j].dot(&n) >= -self.rules.floor * n.norm()
     }
 

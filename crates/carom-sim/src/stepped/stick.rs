@@ -33,7 +33,7 @@ use carom_response::{Body, Contact, Response, RigidCluster};
 use nalgebra::Const;
 
 use super::clusters::{Clusters, FREE, Motion, StuckCluster};
-use super::response::{Contacts, Effect, Surface};
+use super::response::{Contacts, Effect, Surface, touch_tolerance};
 use super::stack::{Approach, Seed, SeedOther};
 
 /// One side of a contact: a free ball or a cluster.
@@ -168,7 +168,7 @@ where
         // A slow contact onto a held body below is resting: no impulse (the collapse
         // guard's elastic one would juggle a ball on a resting cluster, gaining energy);
         // the hold stops it.
-        let onto_support = slow && self.onto_held(i, j, &n);
+        let onto_support = slow && self.onto_held([i, j], [&xi, &xj], &n);
         let effect = Effect {
             collided: r.applied() && !slow,
         };
@@ -188,15 +188,23 @@ where
         Ok(effect)
     }
 
-    /// Whether, of balls `i` and `j` (along `n` from `i` to `j`), the lower one along
-    /// gravity is held in this step (see `stack`) and, if it is a free ball, does not
-    /// move up into the other: the upper one then lands on a support.
-    fn onto_held(&self, i: usize, j: usize, n: &Vector<T, D>) -> bool {
+    /// Whether, of balls `i` at `xi` and `j` at `xj` (along `n` from `i` to `j`), the lower
+    /// one along gravity (not side by side, see
+    /// [`Rules::lies_below`](super::response::Rules::lies_below)) is held in this step
+    /// (see `stack`) and, if it is a free ball, does not move up into the other: the upper
+    /// one then lands on a support.
+    fn onto_held(
+        &self,
+        [i, j]: [usize; 2],
+        [xi, xj]: [&Vector<T, D>; 2],
+        n: &Vector<T, D>,
+    ) -> bool {
         let balls = &*self.balls;
-        let down = self.rules.gravity.dot(n);
-        let (low, normal) = if down > T::zero() {
+        let offset = xj - xi;
+        let level = touch_tolerance(xi, balls.radius[i]) + touch_tolerance(xj, balls.radius[j]);
+        let (low, normal) = if self.rules.lies_below(&offset, level) {
             (j, *n)
-        } else if down < T::zero() {
+        } else if self.rules.lies_below(&-offset, level) {
             (i, -n)
         } else {
             return false;
