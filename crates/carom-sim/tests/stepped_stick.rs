@@ -14,6 +14,7 @@ use carom_sim::plan::{RunOptions, plan};
 use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Inelastic, Scene, World};
 use carom_sim::scenes::collision_lab::{InelasticPreset, Options, Screen, scene};
 use carom_sim::scenes::gas::{GasParams, gas};
+use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Collision, EngineKind, EventEngine, Simulation, observe};
 use carom_toi::Direction;
 use common::{Recorder, states, stepped};
@@ -959,6 +960,40 @@ fn fast_tumbler() -> Scene<f64, 3> {
     s
 }
 
+/// Runs `s` (in a border) with `integrator` for `steps` steps of `dt`, asserting after
+/// each that the energy rose by no more than 1e-5 of itself; returns the engine and the
+/// farthest any ball got outside the border.
+fn run_in_box(
+    s: &Scene<f64, 3>,
+    integrator: Integrator,
+    dt: f64,
+    steps: u32,
+    rec: &mut Recorder<f64>,
+) -> (SteppedEngine<f64, 3>, f64) {
+    let mut sim = stepped(s, integrator, dt);
+    let border = s.world.border.as_ref().unwrap().border;
+    let mut outside = 0.0_f64;
+    let mut e_before = observe::energy(s, &states(&sim));
+    for k in 1..=steps {
+        sim.advance_to(f64::from(k) * dt, rec).unwrap();
+        let st = states(&sim);
+        let e = observe::energy(s, &st);
+        assert!(
+            e <= e_before * (1.0 + 1e-5),
+            "{integrator}, step {k}: energy {e_before} -> {e}"
+        );
+        e_before = e;
+        for (b, x) in s.balls.iter().zip(&st.pos) {
+            for a in 0..3 {
+                outside = outside
+                    .max(border.min()[a] - (x[a] - b.radius))
+                    .max(x[a] + b.radius - border.max()[a]);
+            }
+        }
+    }
+    (sim, outside)
+}
+
 #[test]
 fn a_cluster_turning_radians_per_step_against_the_walls_finishes_every_step_inside_the_box() {
     // A member that touches a wall moving away from it, which the rotation brings back
@@ -978,28 +1013,8 @@ fn a_cluster_turning_radians_per_step_against_the_walls_finishes_every_step_insi
         Integrator::Rk4,
         Integrator::Exact,
     ] {
-        let mut sim = stepped(&s, integrator, dt);
         let mut rec = Recorder::default();
-        let border = s.world.border.as_ref().unwrap().border;
-        let mut outside = 0.0_f64;
-        let mut e_before = observe::energy(&s, &states(&sim));
-        for k in 1..=100 {
-            sim.advance_to(f64::from(k) * dt, &mut rec).unwrap();
-            let st = states(&sim);
-            let e = observe::energy(&s, &st);
-            assert!(
-                e <= e_before * (1.0 + 1e-5),
-                "{integrator}, step {k}: energy {e_before} -> {e}"
-            );
-            e_before = e;
-            for (b, x) in s.balls.iter().zip(&st.pos) {
-                for a in 0..3 {
-                    outside = outside
-                        .max(border.min()[a] - (x[a] - b.radius))
-                        .max(x[a] + b.radius - border.max()[a]);
-                }
-            }
-        }
+        let (sim, outside) = run_in_box(&s, integrator, dt, 100, &mut rec);
         let stats = sim.stats();
         assert_eq!(stats.capped_steps, 0, "{integrator}: {stats:?}");
         assert!(stats.max_contacts_in_step <= 100, "{integrator}: {stats:?}");
@@ -1071,27 +1086,9 @@ fn a_cluster_fused_spinning_fast_within_a_step_is_followed_in_sub_steps_from_the
     for b in &mut s.balls {
         b.vel *= 30.0;
     }
-    let border = s.world.border.as_ref().unwrap().border;
     for integrator in Integrator::ALL {
-        let mut sim = stepped(&s, integrator, 0.01);
-        let mut e_before = observe::energy(&s, &states(&sim));
-        for k in 1..=5 {
-            sim.advance_to(f64::from(k) * 0.01, &mut ()).unwrap();
-            let st = states(&sim);
-            let e = observe::energy(&s, &st);
-            assert!(
-                e <= e_before * (1.0 + 1e-5),
-                "{integrator}, step {k}: energy {e_before} -> {e}"
-            );
-            e_before = e;
-            for (b, x) in s.balls.iter().zip(&st.pos) {
-                for a in 0..3 {
-                    let out = (border.min()[a] - (x[a] - b.radius))
-                        .max(x[a] + b.radius - border.max()[a]);
-                    assert!(out <= 1e-9, "{integrator}, step {k}: {out} m outside");
-                }
-            }
-        }
+        let (sim, outside) = run_in_box(&s, integrator, 0.01, 5, &mut Recorder::default());
+        assert!(outside <= 1e-9, "{integrator}: {outside} m outside");
         assert!(
             sim.stats().substeps >= 1000,
             "{integrator}: {:?}",
