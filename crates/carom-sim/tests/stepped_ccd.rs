@@ -140,6 +140,71 @@ fn a_ball_trapped_between_a_box_and_a_wall_bounces_every_time_within_a_step() {
     assert!(sim.stats().max_contacts_in_step >= 60);
 }
 
+/// A ball sliding along a wall, within rounding of it and pressed into it by less than
+/// the engine counts as approaching, must still meet the next wall: the narrow phase
+/// reported the wall it slides on as hit once rounding closed the gap, took that for no
+/// contact, and lost the floor behind it (found by random scenes: a 1 kg ball squeezed
+/// down a wall at 3.1e4 m/s by a 1e6 kg ball left the box through the floor).
+/// - Without gravity, 2.8e-16 m off the left wall, pressed in at 1.7e-10 m/s (below the
+///   rounding of its speed) and moving down at 3.1e4 m/s: it bounces between floor and
+///   ceiling as the triangle wave of its vertical motion (about 80 bounces in the step;
+///   before, it ended the step 312 m below the floor).
+/// - Under gravity, 1e-12 m off the wall, pressed in at 1e-8 m/s (below the resting floor)
+///   and falling at 3 m/s from 1 cm above the floor: it bounces (before, it ended the
+///   step 2.1 cm through the floor).
+#[test]
+fn a_ball_sliding_along_a_wall_meets_the_next_wall() {
+    let (r, vy) = (0.05, -31269.83974109964);
+    let border = BorderSpec {
+        border: Border::new(Vector2::repeat(-2.0), Vector2::repeat(2.0)).unwrap(),
+        restitution: 1.0,
+        periodic: false,
+    };
+    let ball = |x: f64, y: f64, vx: f64, vy: f64| {
+        BallSpec::new(Vector2::new(x, y), Vector2::new(vx, vy), r, 1.0)
+    };
+    let fast = Scene {
+        world: World {
+            border: Some(border.clone()),
+            ..World::default()
+        },
+        balls: vec![ball(
+            -1.9499999999999997,
+            -1.7153294028672454,
+            -1.6689227777533233e-10,
+            vy,
+        )],
+        ..Scene::default()
+    };
+    let falling = Scene {
+        world: World {
+            gravity: Vector2::new(0.0, -9.81),
+            border: Some(border),
+            ..World::default()
+        },
+        balls: vec![ball(-1.949999999999, -1.94, -1e-8, -3.0)],
+        ..Scene::default()
+    };
+    for integrator in Integrator::ALL {
+        let mut sim = stepped(&fast, integrator, 0.01);
+        sim.advance_to(0.01, &mut ()).unwrap();
+        let st = states(&sim);
+        let want = triangle_wave(-1.7153294028672454, vy, -1.95, 1.95, 0.01);
+        assert!(
+            (st.pos[0].y - want).abs() < 1e-6,
+            "{integrator}: {:?}, want y = {want}",
+            st.pos[0]
+        );
+        assert!(st.pos[0].x >= -1.95 - 1e-9, "{integrator}: {:?}", st.pos[0]);
+        let mut sim = stepped(&falling, integrator, 0.01);
+        sim.advance_to(0.01, &mut ()).unwrap();
+        let st = states(&sim);
+        assert!(st.pos[0].y >= -1.95 - 1e-9, "{integrator}: {:?}", st.pos[0]);
+        assert!(st.vel[0].y > 0.0, "{integrator}: {:?}", st.vel[0]);
+        assert!(st.pos[0].x >= -1.95 - 1e-9, "{integrator}: {:?}", st.pos[0]);
+    }
+}
+
 #[test]
 fn a_ball_at_a_million_metres_per_second_stays_in_the_border_and_out_of_thin_boxes() {
     // A thin rotated plate (1 mm thick) across the middle of a 3D box, and a ball shot
