@@ -165,7 +165,7 @@ fn a_ball_sliding_along_a_wall_meets_the_next_wall() {
     };
     let fast = Scene {
         world: World {
-            border: Some(border.clone()),
+            border: Some(border),
             ..World::default()
         },
         balls: vec![ball(
