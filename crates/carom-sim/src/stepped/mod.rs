@@ -838,8 +838,7 @@ where
             let normal = (y - x) / d;
             // Below the ball (not beside it on a common floor), and not moving up into it
             // (within rounding): it can hold it.
-            let level = tolerance + touch_tolerance(&y, b.radius[j]);
-            if self.rules.lies_below(&(y - x), level)
+            if self.rules.lies_below((&x, r), (&y, b.radius[j]))
                 && b.chord[j].dot(&normal) >= -self.rules.floor
             {
                 out.push(Touch {

@@ -73,10 +73,6 @@ pub(crate) struct Rules<T: Real, const D: usize> {
     /// what gravity adds in a step plus `64 ε` times the scene's speed scale (the fastest
     /// ball or box at the start).
     pub(crate) floor: T,
-    /// `2 floor h`: how much more than their touching tolerances two balls resting on
-    /// one floor may differ in height (what the resting corrections leave, a resting
-    /// ball sinking by up to `floor` over a step); see [`Self::lies_below`].
-    pub(crate) level: T,
     /// `inelastic = "stick"`: two balls whose pair restitution is 0 fuse (see `stick`).
     pub(crate) stick: bool,
 }
@@ -101,7 +97,6 @@ impl<T: Real, const D: usize> Rules<T, D> {
             .fold(g * h, T::max);
         let collapse_speed = (g * h).max(T::lit(1e-6) * speed).max(T::MIN_POSITIVE);
         let bad_step = |e: carom_math::InvalidValue| SceneError::new("--dt", e.to_string());
-        let floor = T::lit(1e-6) * g * h + T::lit(64.0) * T::EPSILON * speed;
         Ok(Self {
             friction: world.friction,
             border_restitution: world.border.as_ref().map_or_else(T::one, |b| b.restitution),
@@ -109,24 +104,36 @@ impl<T: Real, const D: usize> Rules<T, D> {
             resting: RestingGuard::new(T::lit(2.0) * h).map_err(bad_step)?,
             collapse: CollapseGuard::elastic_below(collapse_speed).map_err(bad_step)?,
             support_speed: T::lit(2.0) * g * h,
-            floor,
-            level: T::lit(2.0) * floor * h,
+            floor: T::lit(1e-6) * g * h + T::lit(64.0) * T::EPSILON * speed,
             stick: world.inelastic == Inelastic::Stick,
         })
     }
 
-    /// Whether a ball whose centre lies at `offset` from another's lies below it along
-    /// gravity, so that it can hold it up (shock propagation): lower by more than two
-    /// balls resting on one floor can differ in height, their touching tolerances
-    /// `tolerance` (both summed, see [`touch_tolerance`]) and [`Self::level`]. Two balls
-    /// side by side on a floor hold each other up neither way: taking the one that had
-    /// sunk 3e-10 m deeper for an immovable support stopped a ball rolling slowly into it
-    /// dead (its momentum and energy lost), and a ball a kinematic box pushed into it
-    /// could not give way (a false crush, found by random scenes).
-    pub(crate) fn lies_below(&self, offset: &Vector<T, D>, tolerance: T) -> bool {
-        self.gravity.dot(offset) > self.gravity.norm() * (tolerance + self.level)
+    /// Whether ball `lower` (centre and radius) lies below ball `upper` along gravity, so
+    /// that it can hold it up (shock propagation): its centre lower by more than the
+    /// rounding of both balls' contacts ([`touch_tolerance`]) plus [`SIDE_BY_SIDE`]
+    /// times the distance between the centres. Two balls side by side on a floor hold
+    /// each other up neither way: taking a neighbour 1e-10 m lower for an immovable
+    /// support stopped a ball rolling slowly into it dead (its momentum and energy
+    /// lost), and one 3e-10 m lower made a ball a kinematic box pushed into it look
+    /// crushed (a fuzzed scene).
+    pub(crate) fn lies_below(&self, upper: (&Vector<T, D>, T), lower: (&Vector<T, D>, T)) -> bool {
+        let offset = lower.0 - upper.0;
+        let margin = touch_tolerance(upper.0, upper.1)
+            + touch_tolerance(lower.0, lower.1)
+            + T::lit(SIDE_BY_SIDE) * offset.norm();
+        self.gravity.dot(&offset) > self.gravity.norm() * margin
     }
 }
+
+/// How far below the horizontal (as the sine of the angle) the line from a ball's centre
+/// to another's must dip for the other to hold it up ([`Rules::lies_below`]). Balls
+/// resting on one floor differ in height by what they sank at landing: up to 2.2e-8 m
+/// (measured: a ball sliding on the floor of a fuzzed scene, exact integrator, `h =
+/// 0.01`), 1.1e-7 of the distance between two centres 0.2 m apart; `f32` rounds
+/// coordinates near 2 m to 2.4e-7 m. A contact within 1e-4 rad of the horizontal takes
+/// at most 1e-4 of its push as support: it is a side contact, not a support.
+pub(crate) const SIDE_BY_SIDE: f64 = 1e-4;
 
 /// The gap within which a ball of radius `r` at `x` touches a surface or a ball: a
 /// billionth of its radius plus the rounding of its coordinates.

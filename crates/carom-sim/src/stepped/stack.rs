@@ -859,10 +859,9 @@ where
             .periodic
             .map_or(y, |border| p + border.minimum_image(&(y - p)));
         let n = y - p;
-        let level = touch_tolerance(&p, b.radius[x]) + touch_tolerance(&y, b.radius[j]);
         x != j
             && b.supported[j]
-            && self.rules.lies_below(&n, level)
+            && self.rules.lies_below((&p, b.radius[x]), (&y, b.radius[j]))
             && b.chord[j].dot(&n) >= -self.rules.floor * n.norm()
     }
 

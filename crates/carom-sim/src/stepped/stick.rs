@@ -33,7 +33,7 @@ use carom_response::{Body, Contact, Response, RigidCluster};
 use nalgebra::Const;
 
 use super::clusters::{Clusters, FREE, Motion, StuckCluster};
-use super::response::{Contacts, Effect, Surface, touch_tolerance};
+use super::response::{Contacts, Effect, Surface};
 use super::stack::{Approach, Seed, SeedOther};
 
 /// One side of a contact: a free ball or a cluster.
@@ -200,11 +200,10 @@ where
         n: &Vector<T, D>,
     ) -> bool {
         let balls = &*self.balls;
-        let offset = xj - xi;
-        let level = touch_tolerance(xi, balls.radius[i]) + touch_tolerance(xj, balls.radius[j]);
-        let (low, normal) = if self.rules.lies_below(&offset, level) {
+        let (ball_i, ball_j) = ((xi, balls.radius[i]), (xj, balls.radius[j]));
+        let (low, normal) = if self.rules.lies_below(ball_i, ball_j) {
             (j, *n)
-        } else if self.rules.lies_below(&-offset, level) {
+        } else if self.rules.lies_below(ball_j, ball_i) {
             (i, -n)
         } else {
             return false;
