@@ -229,6 +229,13 @@ where
         )
     }
 
+    /// The angular speed `|ω|` (rad/s).
+    #[inline]
+    pub fn angular_speed(&self) -> T {
+        let w = self.angular_velocity();
+        <Const<D> as Space<T, D>>::angular_dot(&w, &w).sqrt()
+    }
+
     /// The linear momentum `M v`.
     #[inline]
     pub fn linear_momentum(&self) -> Vector<T, D> {

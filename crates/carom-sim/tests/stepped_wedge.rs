@@ -383,18 +383,16 @@ fn a_plank_squeezing_a_ball_into_its_neighbour_on_the_floor_moves_both_whatever_
         };
         for integrator in Integrator::ALL {
             let what = format!("{integrator:?}, right ball {offset} m higher");
+            let mut end = Vec::new();
             let stats = run_steps(&s, integrator, 80, |step, st, _, _| {
                 assert_apart_and_inside(&s, st, &format!("{what}, {step}"), 1e-9);
+                end.clone_from(&st.vel);
             });
             assert_eq!(stats.capped_steps, 0, "{what}");
-            let mut sim = stepped(&s, integrator, DT);
-            sim.advance_to(0.8, &mut ()).unwrap();
-            let st = states(&sim);
-            for k in 0..2 {
+            for (k, v) in end.iter().enumerate() {
                 assert!(
-                    (st.vel[k].x - want).abs() < 1e-9 * want,
-                    "{what}: ball {k} at {:?}, want {want} m/s",
-                    st.vel[k]
+                    (v.x - want).abs() < 1e-9 * want,
+                    "{what}: ball {k} at {v:?} at 0.8 s, want {want} m/s"
                 );
             }
         }

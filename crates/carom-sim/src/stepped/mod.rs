@@ -78,9 +78,7 @@ use self::wedge::{CRUSH_CONTACTS, Repeat, Repeats};
 /// Escapees per parallel task of the step's first predictions (each is a broad-phase
 /// query and a few times of impact: 1.4 µs on average, timed on a 1e5-ball gas).
 const ESCAPEE_CHUNK: usize = 32;
-use crate::engine::{
-    Angular, BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation,
-};
+use crate::engine::{BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation};
 use crate::plan::{DEFAULT_DT, Plan, can_stick, stepped_broad_phase};
 use crate::scene::{Scene, SceneError};
 
@@ -877,11 +875,10 @@ where
     /// Whether a cluster of the `changed` balls would now turn more than [`MAX_TURN`]
     /// over the `rest` of the step (at its spin at either end of its segment).
     fn spun_up(&self, changed: &[u32], rest: f64) -> bool {
-        let spin = |w: Angular<T, D>| <Const<D> as Space<T, D>>::angular_dot(&w, &w).sqrt();
         changed.iter().any(|&m| {
             Clusters::of(&self.balls, m as usize).is_some_and(|c| {
                 let c = &self.clusters.list[c];
-                let fastest = spin(c.start.angular_velocity()).max(spin(c.end.angular_velocity()));
+                let fastest = c.start.angular_speed().max(c.end.angular_speed());
                 fastest.to_f64() * rest > MAX_TURN
             })
         })
@@ -1049,8 +1046,7 @@ where
     /// `None` without clusters).
     fn fastest_spin(&self) -> (T, Option<usize>) {
         (self.clusters.list.iter().enumerate()).fold((T::zero(), None), |best, (k, c)| {
-            let w = c.end.angular_velocity();
-            let spin = <Const<D> as Space<T, D>>::angular_dot(&w, &w).sqrt();
+            let spin = c.end.angular_speed();
             if spin > best.0 || !spin.finite() {
                 (spin, Some(k))
             } else {
@@ -1115,7 +1111,6 @@ where
             let ended = awake::hold_pool(parallel, || {
                 self.run_window(b, h, t0, &mut step_contacts, observer)
             });
-            let mut taken = h;
             a = match ended? {
                 WindowEnd::Done => b,
                 WindowEnd::Cut(s) => s,
@@ -1125,15 +1120,12 @@ where
                 }
                 WindowEnd::Spun(s) => {
                     self.end_at(s, h, t0);
-                    taken = s;
-                    h
+                    self.wrap(s, h, t0);
+                    self.finish_step(step_contacts);
+                    return Ok(s);
                 }
             };
-            self.wrap(a.min(taken), h, t0);
-            if taken < h {
-                self.finish_step(step_contacts);
-                return Ok(taken);
-            }
+            self.wrap(a, h, t0);
         }
         self.finish_step(step_contacts);
         Ok(h)
