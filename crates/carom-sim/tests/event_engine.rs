@@ -10,6 +10,7 @@ use carom_sim::scenes::gas::{GasParams, gas};
 use carom_sim::{BallStates, Collision, EngineKind, EventEngine, Observer, Simulation};
 use carom_toi::Direction;
 use nalgebra::{Const, Vector2, Vector3};
+use proptest::prelude::*;
 
 fn plan(broad: BroadChoice) -> Plan {
     Plan {
@@ -464,6 +465,196 @@ fn an_inelastic_column_does_not_collapse_under_the_tc_model() {
     let (st, log) = run(&scene, 50.0, BroadChoice::Auto);
     assert!(log.len() < 2_000_000, "{} events", log.len());
     assert!(min_gap(&scene, &st) >= -1e-9);
+}
+
+/// A world with the border `[-2, 2]²` of restitution `border_e`, gravity `gravity` and
+/// ball restitution `e`.
+fn boxed_world(gravity: f64, e: f64, border_e: f64) -> World<f64, 2> {
+    World {
+        gravity: Vector2::new(0.0, -gravity),
+        restitution: e,
+        border: Some(BorderSpec {
+            border: Border::new(Vector2::new(-2.0, -2.0), Vector2::new(2.0, 2.0)).unwrap(),
+            restitution: border_e,
+            periodic: false,
+        }),
+        ..World::default()
+    }
+}
+
+#[test]
+fn a_light_ball_pinned_to_a_wall_by_a_heavy_one_is_struck_galperins_pi_count_of_times() {
+    // Galperin's billiard: a ball of mass M closing on a ball of mass m = M / 100^k at
+    // rest against a wall, all elastic, makes as many collisions (with the ball and the
+    // wall) as the first k + 1 digits of π: 3141 at the mass ratio 1e6. Touching at the
+    // contact (t = 0.5 s, where positions no longer resolve the light ball's shuttling),
+    // all 3141 come at one instant: 25 times the 128 that used to end the run as a
+    // cascade that does not end.
+    let scene = Scene {
+        name: None,
+        world: boxed_world(0.0, 1.0, 1.0),
+        balls: vec![
+            BallSpec::new(Vector2::new(1.2, 0.0), Vector2::new(1.0, 0.0), 0.1, 1.0),
+            BallSpec::new(Vector2::new(1.9, 0.0), Vector2::zeros(), 0.1, 1e-6),
+        ],
+        boxes: Vec::new(),
+    };
+    let (st, log) = run(&scene, 1.0, BroadChoice::Auto);
+    assert_eq!(log.len(), 3141);
+    assert!(log.iter().all(|c| (c.time() - 0.5).abs() < 1e-15));
+    let walls = log
+        .iter()
+        .filter(|c| matches!(c, Collision::BallBorder { .. }))
+        .count();
+    assert_eq!(walls, 1570, "the ball-ball and wall collisions alternate");
+    let e0 = energy(&scene, &run(&scene, 0.0, BroadChoice::Auto).0);
+    assert!((energy(&scene, &st) - e0).abs() < 1e-12 * e0);
+    // Both move away from the wall, the light ball no faster than the heavy one: no
+    // collision is left.
+    let (heavy, light) = (st.vel[0].x, st.vel[1].x);
+    assert!(
+        heavy < 0.0 && light <= 0.0 && light >= heavy,
+        "{heavy} {light}"
+    );
+}
+
+#[test]
+fn a_ball_a_moving_box_corner_presses_into_the_floor_is_squeezed_out_at_the_speed_it_sets() {
+    // Reduced from fuzzed scene s58: a rotated box coming down at 2.9 m/s meets a ball
+    // resting on the floor with its lower corner, restitution 0 at the box and 0.5 at
+    // the floor. The ball is squeezed out along the floor at the speed that keeps it
+    // touching the corner: with n the unit normal from the corner to the centre at the
+    // first contact and u the box's velocity, v = (u·n / n_x, 0). The cascade left the
+    // ball sliding exactly along the corner; the prediction then found it closing by
+    // rounding while the bounce found nothing to do, forever (the run ended at the
+    // contact with "more than 64 events at one instant").
+    let (centre, half, angle) = (
+        Vector2::new(1.744_439_320_753_702_1, -1.608_408_870_576_545_4),
+        Vector2::new(0.118_911_917_264_444_8, 0.191_027_437_936_365_4),
+        0.691_995_147_721_346_6,
+    );
+    let u = Vector2::new(0.480_042_551_663_934_17, -2.925_423_408_329_608_3);
+    let ball = Vector2::new(1.700_000_000_000_000_2, -1.9);
+    let scene = Scene {
+        name: None,
+        world: boxed_world(9.81, 0.0, 0.5),
+        balls: vec![BallSpec::new(ball, Vector2::zeros(), 0.1, 1.0)],
+        boxes: vec![BoxSpec {
+            shape: Obb::from_angle(centre, half, angle).unwrap(),
+            vel: u,
+            restitution: 0.0,
+        }],
+    };
+    // The lower corner, and the first time it is 0.1 from the centre (bisection).
+    let corner = |t: f64| {
+        let (c, s) = (angle.cos(), angle.sin());
+        centre + u * t + Vector2::new(-c * half.x + s * half.y, -s * half.x - c * half.y)
+    };
+    let (mut lo, mut hi) = (0.0, 0.01);
+    assert!((corner(lo) - ball).norm() > 0.1 && (corner(hi) - ball).norm() < 0.1);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if (corner(mid) - ball).norm() > 0.1 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let n = (ball - corner(lo)) / 0.1;
+    let v = u.dot(&n) / n.x;
+    let (st, log) = run(&scene, 0.01, BroadChoice::Auto);
+    assert!(log.len() < 100, "{} collisions", log.len());
+    let first = log.iter().find(|c| matches!(c, Collision::BallBox { .. }));
+    assert!(
+        (first.unwrap().time() - lo).abs() < 1e-12,
+        "{first:?} vs {lo}"
+    );
+    // The bounces of the squeeze have flights: it lasts 1.2e-9 s, in which the corner
+    // moves 5e-9 m past the ball and turns the normal by 5e-8 rad, 2.4e-7 m/s in v.
+    let squeeze = log.last().unwrap().time() - lo;
+    assert!(squeeze < 1e-8, "the squeeze lasts {squeeze} s");
+    assert!(
+        (st.vel[0] - Vector2::new(v, 0.0)).norm() < 1e-6,
+        "{:?} vs {v}",
+        st.vel[0]
+    );
+    assert!((st.pos[0] - Vector2::new(ball.x + v * (0.01 - lo), -1.9)).norm() < 1e-8);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+
+    /// Two touching balls sliding past each other exert no impulse: the run passes
+    /// them unchanged. The prediction and the response compute the pair's normal
+    /// velocity, zero but for rounding, in different orders; where the prediction
+    /// found it closing and the impulse nothing to do, the same contact came due at
+    /// once, forever ("more than 128 events at one instant").
+    #[test]
+    fn touching_balls_sliding_past_each_other_pass_unchanged(
+        angle in 0.0..std::f64::consts::TAU,
+        x in -1e3..1e3f64,
+        y in -1e3..1e3f64,
+        vx in -5.0..5.0f64,
+        vy in -5.0..5.0f64,
+        slide in -5.0..5.0f64,
+        ra in 0.01..1.0f64,
+        rb in 0.01..1.0f64,
+        log_mass in -6.0..6.0f64,
+    ) {
+        let n = Vector2::new(angle.cos(), angle.sin());
+        let (pa, v) = (Vector2::new(x, y), Vector2::new(vx, vy));
+        let vb = v + Vector2::new(-n.y, n.x) * slide;
+        let scene = Scene {
+            name: None,
+            world: World::default(),
+            balls: vec![
+                BallSpec::new(pa, v, ra, 1.0),
+                BallSpec::new(pa + n * (ra + rb), vb, rb, 10f64.powf(log_mass)),
+            ],
+            boxes: Vec::new(),
+        };
+        let (st, log) = run(&scene, 1.0, BroadChoice::Auto);
+        prop_assert!(log.len() <= 2, "{} collisions", log.len());
+        prop_assert!((st.vel[0] - v).norm() < 1e-9 && (st.vel[1] - vb).norm() < 1e-9);
+        prop_assert!(min_gap(&scene, &st) > -1e-9);
+    }
+
+    /// As above, a ball touching a face of a moving rotated box and sliding along it.
+    #[test]
+    fn a_ball_sliding_along_a_moving_box_face_passes_unchanged(
+        angle in 0.0..std::f64::consts::TAU,
+        x in -1e3..1e3f64,
+        y in -1e3..1e3f64,
+        ux in -5.0..5.0f64,
+        uy in -5.0..5.0f64,
+        slide in -5.0..5.0f64,
+        radius in 0.01..1.0f64,
+        hx in 0.05..1.0f64,
+        hy in 0.05..1.0f64,
+        along in -1.0..1.0f64,
+        restitution in 0.0..1.0f64,
+    ) {
+        let (n, centre, u) = (
+            Vector2::new(angle.cos(), angle.sin()),
+            Vector2::new(x, y),
+            Vector2::new(ux, uy),
+        );
+        let t = Vector2::new(-n.y, n.x);
+        let v = u + t * slide;
+        let scene = Scene {
+            name: None,
+            world: World::default(),
+            balls: vec![BallSpec::new(centre + n * (hx + radius) + t * (along * hy), v, radius, 1.0)],
+            boxes: vec![BoxSpec {
+                shape: Obb::from_angle(centre, Vector2::new(hx, hy), angle).unwrap(),
+                vel: u,
+                restitution,
+            }],
+        };
+        let (st, log) = run(&scene, 1.0, BroadChoice::Auto);
+        prop_assert!(log.len() <= 2, "{} collisions", log.len());
+        prop_assert!((st.vel[0] - v).norm() < 1e-9, "{:?} vs {v:?}", st.vel[0]);
+    }
 }
 
 #[test]
