@@ -5,7 +5,9 @@
 //! observer, and re-predicts the balls whose motion changed. A stale event (the partner
 //! collided since it was predicted) only re-predicts. Restitution passes through the
 //! guards first: the TC model for ball–ball collisions, the resting guard for bounces on
-//! a surface that gravity presses the ball onto.
+//! a surface that gravity presses the ball onto. Every resolved contact leaves at least
+//! at the rounding speed of its velocities, so that rounding cannot bring the same
+//! contact due again at once ([`parting_impulse`]).
 
 use carom_geometry::query::PointQuery;
 use carom_math::{Real, Space, Vector};
