@@ -401,11 +401,20 @@ where
         for m in (0..D).filter(|&m| local[m].abs() > h[m]) {
             outside = (outside.0 + 1, m);
         }
-        let support = (outside.0 == 1).then(|| Support::BoxFace {
-            k,
-            axis: outside.1,
-            upper: local[outside.1] > T::zero(),
-        });
+        // A face the ball leaves within the resting guard's shortest flight (it reaches
+        // the face's end) holds it no more than a corner does: resting there, it was
+        // freed at once and met the box again at the same instant, forever (fuzzed s31:
+        // a ball sliding off a face at 2e5 m/s).
+        let support = (outside.0 == 1)
+            .then(|| Support::BoxFace {
+                k,
+                axis: outside.1,
+                upper: local[outside.1] > T::zero(),
+            })
+            .filter(|_| {
+                self.face_exit_time(i, k, outside.1)
+                    .is_none_or(|s| s > self.resting.min_flight_time())
+            });
         if self.bounce(i, normal, point, b.vel, b.restitution, support) {
             self.counters.ball_box += 1;
             observer.collision(&Collision::BallBox {

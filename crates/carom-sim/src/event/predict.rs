@@ -245,7 +245,7 @@ where
 
     /// When the centre of resting ball `i` leaves the face (axis `axis`) of box `k` it
     /// rests on: the first time a tangential box-local coordinate crosses `±h`.
-    fn face_exit_time(&self, i: usize, k: usize, axis: usize) -> Option<T> {
+    pub(crate) fn face_exit_time(&self, i: usize, k: usize, axis: usize) -> Option<T> {
         let b = &self.boxes[k];
         let obb = b.at(self.now);
         let local = obb.to_local(&self.balls.position_at(i, self.now));
