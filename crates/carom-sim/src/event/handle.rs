@@ -7,7 +7,7 @@
 //! guards first: the TC model for ball–ball collisions, the resting guard for bounces on
 //! a surface that gravity presses the ball onto. Every resolved contact leaves at least
 //! at the rounding speed of its velocities, so that rounding cannot bring the same
-//! contact due again at once ([`parting_impulse`]).
+//! contact due again at once ([`parting_shortfall`]).
 
 use carom_geometry::query::PointQuery;
 use carom_math::{Real, Space, Vector};
@@ -260,9 +260,10 @@ where
             T::one() / self.balls.props[i].mass,
             T::one() / self.balls.props[j].mass,
         );
-        let Some(impulse) = parting_impulse(&vi, &vj, wi + wj, normal) else {
+        let Some(shortfall) = parting_shortfall(&vi, &vj, normal) else {
             return false;
         };
+        let impulse = *normal * (shortfall / (wi + wj));
         self.balls.motion[i].vel = vi - impulse * wi;
         self.balls.motion[j].vel = vj + impulse * wj;
         true
@@ -307,7 +308,8 @@ where
         let approach = -normal_velocity(&a, &b, &contact);
         let mut e = self.surface_restitution(i, surface_restitution);
         let pressing = self.gravity.dot(&normal);
-        let rest = support.is_some() && self.resting.decide(approach, e, pressing) == Bounce::Rest;
+        let rest = self.resting.decide(approach, e, pressing) == Bounce::Rest
+            && support.is_some_and(|s| self.holds(i, s));
         if rest {
             e = T::zero();
         }
@@ -317,42 +319,52 @@ where
             &contact,
             &Coefficients::new_unchecked(e, self.friction),
         );
-        if rest {
-            if !response.applied() {
-                return false;
-            }
-            // Rest exactly: no normal velocity relative to the surface, no normal
-            // acceleration; gravity's tangential part still drives the ball.
-            let v = response.velocity[0];
-            self.balls.motion[i].vel = v - normal * (v - surface_velocity).dot(&normal);
-            if self.friction > T::zero() {
-                self.balls.props[i].spin = response.angular_velocity[0];
-            }
-            self.changed(i);
-            self.balls.accel[i] = self.gravity - normal * pressing;
-            if let Some(s) = support {
-                self.balls.mode[i] = Mode::Resting(s);
-            }
-            return true;
-        }
         // Leaving at least at the resolution of the velocities, as two balls do
-        // (`part_by_rounding`): the surface is a body of no inverse mass.
-        let mut v = response.velocity[0];
-        let parting = parting_impulse(&v, &surface_velocity, T::one(), &normal);
-        if let Some(impulse) = parting {
-            v -= impulse;
-        }
-        if !response.applied() && parting.is_none() {
+        // (`part_by_rounding`; the surface is a body of no inverse mass), unless it rests.
+        let shortfall = if rest {
+            None
+        } else {
+            parting_shortfall(&response.velocity[0], &surface_velocity, &normal)
+        };
+        if !response.applied() && shortfall.is_none() {
             return false;
+        }
+        let mut v = response.velocity[0];
+        if let Some(shortfall) = shortfall {
+            v -= normal * shortfall;
+        }
+        if rest {
+            // Rest exactly: no normal velocity relative to the surface.
+            v -= normal * (v - surface_velocity).dot(&normal);
         }
         self.balls.motion[i].vel = v;
         if self.friction > T::zero() {
             self.balls.props[i].spin = response.angular_velocity[0];
         }
         self.changed(i);
-        self.check_support(i);
+        if let (true, Some(s)) = (rest, support) {
+            // No normal acceleration; gravity's tangential part still drives the ball.
+            self.balls.accel[i] = self.gravity - normal * pressing;
+            self.balls.mode[i] = Mode::Resting(s);
+        } else {
+            self.check_support(i);
+        }
         // Only parted by rounding: not a collision.
         response.applied()
+    }
+
+    /// Whether `support` can hold ball `i` at rest: a wall always, a box face unless the
+    /// ball leaves it within the resting guard's shortest flight (it reaches the face's
+    /// end), where it holds it no more than a corner does. Resting there, the ball was
+    /// freed at once and met the box again at the same instant, forever (fuzzed s31: a
+    /// ball sliding off a face at 2e5 m/s).
+    fn holds(&self, i: usize, support: Support) -> bool {
+        match support {
+            Support::Wall { .. } => true,
+            Support::BoxFace { k, axis, .. } => self
+                .face_exit_time(i, k, axis)
+                .is_none_or(|s| s > self.resting.min_flight_time()),
+        }
     }
 
     fn collide_wall(&mut self, i: usize, axis: usize, upper: bool, observer: &mut dyn Observer<T>) {
@@ -401,20 +413,11 @@ where
         for m in (0..D).filter(|&m| local[m].abs() > h[m]) {
             outside = (outside.0 + 1, m);
         }
-        // A face the ball leaves within the resting guard's shortest flight (it reaches
-        // the face's end) holds it no more than a corner does: resting there, it was
-        // freed at once and met the box again at the same instant, forever (fuzzed s31:
-        // a ball sliding off a face at 2e5 m/s).
-        let support = (outside.0 == 1)
-            .then(|| Support::BoxFace {
-                k,
-                axis: outside.1,
-                upper: local[outside.1] > T::zero(),
-            })
-            .filter(|_| {
-                self.face_exit_time(i, k, outside.1)
-                    .is_none_or(|s| s > self.resting.min_flight_time())
-            });
+        let support = (outside.0 == 1).then(|| Support::BoxFace {
+            k,
+            axis: outside.1,
+            upper: local[outside.1] > T::zero(),
+        });
         if self.bounce(i, normal, point, b.vel, b.restitution, support) {
             self.counters.ball_box += 1;
             observer.collision(&Collision::BallBox {
@@ -426,19 +429,16 @@ where
     }
 }
 
-/// The impulse per unit inverse mass, along `normal` (from `a` to `b`), that makes `b`
-/// leave `a` at [`rounding_speed`], if their normal relative velocity is less: `None`
-/// when they already separate at least that fast. `inverse_mass` is the pair's
-/// `1/m_a + 1/m_b`; the impulse acts as `+` on `b` and `−` on `a`, each times its own
-/// inverse mass.
-fn parting_impulse<T: Real, const D: usize>(
+/// How much slower than [`rounding_speed`] `b` leaves `a` along `normal` (from `a` to
+/// `b`), if it does: the normal relative velocity a parting must add. `None` when they
+/// already separate at least that fast.
+fn parting_shortfall<T: Real, const D: usize>(
     a: &Vector<T, D>,
     b: &Vector<T, D>,
-    inverse_mass: T,
     normal: &Vector<T, D>,
-) -> Option<Vector<T, D>> {
+) -> Option<T> {
     let shortfall = rounding_speed(a, b) - (b - a).dot(normal);
-    (shortfall > T::zero()).then(|| normal * (shortfall / inverse_mass))
+    (shortfall > T::zero()).then_some(shortfall)
 }
 
 /// The resolution of a contact's normal relative velocity: `8 u (|v_a| + |v_b|)` (`u`
