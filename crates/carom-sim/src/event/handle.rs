@@ -447,7 +447,7 @@ fn parting_shortfall<T: Real, const D: usize>(
 /// a box contact's in the box's). A pair separating at least this fast is separating
 /// however its normal velocity is computed, and a velocity change this large along a
 /// unit normal (whose largest component is at least `1/√D`) changes a component of
-/// the velocity by several roundings. (Its two roots cost 0.3 % of the instructions of
+/// the velocity by several roundings. (Its two roots cost 0.3-0.4 % of the instructions of
 /// the 3D gas, callgrind; the sum of the components' magnitudes instead cost 1.4 %.)
 fn rounding_speed<T: Real, const D: usize>(a: &Vector<T, D>, b: &Vector<T, D>) -> T {
     T::lit(8.0) * T::EPSILON * (a.norm() + b.norm())
