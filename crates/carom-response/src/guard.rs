@@ -162,6 +162,34 @@ impl<T: Real> RestingGuard<T> {
             Bounce::Rebound
         }
     }
+
+    /// As [`RestingGuard::decide`], and also rest when the rebound would rise less than
+    /// `resolution`: `(e v)² < 2 g_n · resolution`.
+    ///
+    /// `resolution` is the smallest height the caller can represent at the contact, a
+    /// few roundings of its coordinates. Far from the origin it dwarfs the height of the
+    /// shortest flight, `g_n t_min² / 8`: a ball at `y = −702` m (rounding 1.1e-13 m)
+    /// rebounding 1e-6 m/s flies 5e-14 m, below what its position can say. Each contact
+    /// is then placed to the rounding of the position, which may add the flight's whole
+    /// energy back, and such a ball bounced forever at a constant height (5 million
+    /// bounces per simulated second) instead of coming to rest.
+    #[inline]
+    pub fn decide_resolved(
+        &self,
+        approach_speed: T,
+        restitution: T,
+        normal_acceleration: T,
+        resolution: T,
+    ) -> Bounce {
+        let rebound = restitution * approach_speed;
+        let too_low = normal_acceleration > T::zero()
+            && rebound * rebound < T::lit(2.0) * normal_acceleration * resolution;
+        if too_low {
+            Bounce::Rest
+        } else {
+            self.decide(approach_speed, restitution, normal_acceleration)
+        }
+    }
 }
 
 #[cfg(test)]
@@ -203,5 +231,17 @@ mod tests {
             RestingGuard::<f64>::new(-1.0).unwrap_err().field,
             "min_flight_time"
         );
+    }
+
+    #[test]
+    fn resting_guard_rests_when_the_rebound_rises_less_than_the_resolution() {
+        let g = RestingGuard::new(1e-8_f64).unwrap();
+        // g = 10, resolution 1e-12 m: rebounds below √(2·10·1e-12) ≈ 4.47e-6 m/s rest.
+        assert_eq!(g.decide_resolved(4e-6, 1.0, 10.0, 1e-12), Bounce::Rest);
+        assert_eq!(g.decide_resolved(5e-6, 1.0, 10.0, 1e-12), Bounce::Rebound);
+        assert_eq!(g.decide(4e-6, 1.0, 10.0), Bounce::Rebound);
+        // A zero resolution is the plain decision; gravity pulling away never rests.
+        assert_eq!(g.decide_resolved(1e-9, 1.0, 10.0, 0.0), Bounce::Rest);
+        assert_eq!(g.decide_resolved(1e-9, 1.0, -10.0, 1.0), Bounce::Rebound);
     }
 }

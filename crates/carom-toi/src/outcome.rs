@@ -21,12 +21,14 @@ pub enum Status {
     Hit,
     /// At time 0 the bodies already touch or overlap and approach: the event is
     /// immediate (`time` is 0). Approaching means the gap decreases: a negative normal
-    /// rate, or, for overlapping bodies with zero normal rate, an acceleration that
-    /// pushes them deeper (a ball sunk in a wall and falling further out is caught).
-    /// Touching with zero normal rate is resting contact and is not reported.
+    /// rate, or a zero normal rate with an acceleration that pushes them deeper (a ball
+    /// set down on a floor under gravity, or sunk in a wall and falling further out, is
+    /// caught). Touching with zero normal rate and no such acceleration (resting contact
+    /// whose pressing the engine cancels) is not reported.
     AlreadyTouching,
     /// No contact within the window, or only receding or resting contacts. `time` is
-    /// `±∞`, `normal` and `point` are zero.
+    /// `±∞`, `normal` and `point` are zero. (A pair that starts overlapping and receding
+    /// but turns back before it is apart is a [`Status::Hit`] at the turn.)
     NoHit,
     /// An iterative method (conservative advancement) ran out of steps, or an
     /// intermediate value overflowed. `time` is the signed time up to which the absence

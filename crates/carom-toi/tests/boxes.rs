@@ -276,14 +276,19 @@ fn starting_states() {
     assert_eq!((back.status, back.feature), (Status::Hit, BoxFeature::Face));
     assert_relative_eq!(back.time, (3.0 + 5f64.sqrt()) / 10.0, max_relative = 1e-15);
     // Thrown so that it only just reaches the surface (apex exactly at gap 0): it never
-    // separates, so there is no later collision.
+    // separates, and turns back into the box at the apex, t = 0.25: that is its
+    // contact (without it the ball sank through the box unseen).
     // Exactly representable: gap −0.25 + 2t − 4t² peaks at 0.
     let sunk = Ball::new(Vector2::new(0.0, 1.25), 0.5).unwrap();
     let tangent = Kinematics::new(Vector2::new(0.0, 2.0), Vector2::new(0.0, -8.0)).unwrap();
-    assert_eq!(
-        ball_aabb(&sunk, &tangent, &unit_square(), &rest, &forward()).status,
-        Status::NoHit
-    );
+    let turn = ball_aabb(&sunk, &tangent, &unit_square(), &rest, &forward());
+    assert_eq!((turn.status, turn.time), (Status::Hit, 0.25));
+    // Turning back while still overlapping (apex at gap −0.25 + 1 − 1 = −0.25 at
+    // t = 0.25): the contact is the turn.
+    let deep = Kinematics::new(Vector2::new(0.0, 2.0), Vector2::new(0.0, -8.0)).unwrap();
+    let deeper = Ball::new(Vector2::new(0.0, 1.0), 0.5).unwrap();
+    let turn = ball_aabb(&deeper, &deep, &unit_square(), &rest, &forward());
+    assert_eq!((turn.status, turn.time), (Status::Hit, 0.25));
 }
 
 #[test]

@@ -260,7 +260,7 @@ where
             T::one() / self.balls.props[i].mass,
             T::one() / self.balls.props[j].mass,
         );
-        let Some(shortfall) = parting_shortfall(&vi, &vj, normal) else {
+        let Some(shortfall) = parting_shortfall(&vi, &vj, normal, T::zero()) else {
             return false;
         };
         let impulse = *normal * (shortfall / (wi + wj));
@@ -308,7 +308,13 @@ where
         let approach = -normal_velocity(&a, &b, &contact);
         let mut e = self.surface_restitution(i, surface_restitution);
         let pressing = self.gravity.dot(&normal);
-        let rest = self.resting.decide(approach, e, pressing) == Bounce::Rest
+        // The heights the ball's position can resolve: a few roundings of its largest
+        // coordinate (as a prediction's reach).
+        let resolution = T::lit(8.0) * T::EPSILON * self.balls.motion[i].pos.amax();
+        let rest = self
+            .resting
+            .decide_resolved(approach, e, pressing, resolution)
+            == Bounce::Rest
             && support.is_some_and(|s| self.holds(i, s));
         if rest {
             e = T::zero();
@@ -320,13 +326,26 @@ where
             &Coefficients::new_unchecked(e, self.friction),
         );
         // Leaving at least at the resolution of the velocities, as two balls do
-        // (`part_by_rounding`; the surface is a body of no inverse mass), unless it rests.
+        // (`part_by_rounding`; the surface is a body of no inverse mass), and, pressed
+        // onto the surface, fast enough to rise above the resolution of the position,
+        // unless it rests. A ball rebounding from a box's edge at the resolution of its
+        // velocity flew 1e-15 s, too short for its position (at x = 431 m) to move: it
+        // met the same edge again and again while the clock crept on (a ball sliding
+        // off a face at 9 m/s, forever). Rising `resolution` under `g_n` takes
+        // `√(2 g_n resolution)`.
+        let lift = if pressing > T::zero() {
+            (T::lit(2.0) * pressing * resolution).sqrt()
+        } else {
+            T::zero()
+        };
         let shortfall = if rest {
             None
         } else {
-            parting_shortfall(&response.velocity[0], &surface_velocity, &normal)
+            parting_shortfall(&response.velocity[0], &surface_velocity, &normal, lift)
         };
-        if !response.applied() && shortfall.is_none() {
+        // A ball that comes to rest changes its motion even when no impulse was needed
+        // (set down touching at rest): its pressing is cancelled from now on.
+        if !(response.applied() || shortfall.is_some() || rest) {
             return false;
         }
         let mut v = response.velocity[0];
@@ -349,7 +368,7 @@ where
         } else {
             self.check_support(i);
         }
-        // Only parted by rounding: not a collision.
+        // Only parted by rounding, or set down at rest: not a collision.
         response.applied()
     }
 
@@ -429,15 +448,16 @@ where
     }
 }
 
-/// How much slower than [`rounding_speed`] `b` leaves `a` along `normal` (from `a` to
-/// `b`), if it does: the normal relative velocity a parting must add. `None` when they
-/// already separate at least that fast.
+/// How much slower than [`rounding_speed`] (or `least`, if faster) `b` leaves `a` along
+/// `normal` (from `a` to `b`), if it does: the normal relative velocity a parting must
+/// add. `None` when they already separate at least that fast.
 fn parting_shortfall<T: Real, const D: usize>(
     a: &Vector<T, D>,
     b: &Vector<T, D>,
     normal: &Vector<T, D>,
+    least: T,
 ) -> Option<T> {
-    let shortfall = rounding_speed(a, b) - (b - a).dot(normal);
+    let shortfall = rounding_speed(a, b).max(least) - (b - a).dot(normal);
     (shortfall > T::zero()).then_some(shortfall)
 }
 

@@ -629,9 +629,14 @@ where
                 return Err(SimError {
                     time: (self.now * self.sign).to_f64(),
                     message: format!(
-                        "more than {} events at one instant: a cascade of simultaneous collisions that does not end ({})",
+                        "more than {} events at one instant: a cascade of simultaneous collisions that does not end ({}){}",
                         self.events_allowed_at_one_instant,
-                        self.slot_name(i)
+                        self.slot_name(i),
+                        if self.balls.accelerated {
+                            "; under gravity this is usually balls pressed together (a stack, a pile, a wedge), sustained contact that only the stepped engine simulates"
+                        } else {
+                            ""
+                        }
                     ),
                 });
             }

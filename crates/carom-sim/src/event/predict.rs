@@ -35,7 +35,7 @@ where
         let ball = self.ball_at(i, self.now);
         let kin =
             Kinematics::new_unchecked(self.balls.velocity_at(i, self.now), self.balls.accel(i));
-        self.offer_surfaces(&ball, &kin, &mut best);
+        self.offer_surfaces(&ball, &kin, self.support_box(i), &mut best);
         if !self.clusters.is_empty() {
             self.predict_ball_vs_clusters(i, &mut best.time, &mut best.pending);
         }
@@ -117,8 +117,30 @@ where
         best
     }
 
-    /// The first contact of a ball with a border wall or a box.
-    fn offer_surfaces(&self, ball: &Ball<T, D>, kin: &Kinematics<T, D>, best: &mut Best<T>) {
+    /// The box whose face ball `i` rests on, if it rests on one.
+    fn support_box(&self, i: usize) -> Option<usize> {
+        match self.support_of(i) {
+            Some(Support::BoxFace { k, .. }) => Some(k),
+            _ => None,
+        }
+    }
+
+    /// The first contact of a ball with a border wall or a box other than `support` (the
+    /// box it rests on).
+    ///
+    /// A ball resting on a face of a box cannot meet that box until it leaves the face
+    /// (the box is convex), which [`EventEngine::face_exit_time`] schedules. Asked, the
+    /// time of impact sees the ball's velocity and acceleration along a rotated face's
+    /// normal, zero but for rounding, and finds the face due at once whenever that
+    /// rounding points into the box; the response then had nothing to do, and the same
+    /// event came due forever.
+    fn offer_surfaces(
+        &self,
+        ball: &Ball<T, D>,
+        kin: &Kinematics<T, D>,
+        support: Option<usize>,
+        best: &mut Best<T>,
+    ) {
         let now = self.now;
         if let (Some(border), false) = (&self.border, self.periodic) {
             let toi = ball_border(ball, kin, border, &best.window(now));
@@ -134,6 +156,9 @@ where
             }
         }
         for (k, b) in self.boxes.iter().enumerate() {
+            if support == Some(k) {
+                continue;
+            }
             let obb = b.at(now);
             // In a periodic box, the image of the ball nearest the box.
             let image = if self.periodic {

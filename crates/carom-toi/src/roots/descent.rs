@@ -10,7 +10,15 @@
 //!
 //! the first moment the bodies start to interpenetrate after having been apart. It skips
 //! exact tangencies (`g` touches 0 and rises again: a graze, not a collision) and pairs
-//! that start overlapping until they have separated.
+//! that start overlapping until they have separated, unless such a pair stops
+//! separating first (an acceleration pulls it back while it still overlaps by a
+//! rounding): then the descent is where its gap turns and starts to fall,
+//!
+//! ```text
+//! t* = inf { t ∈ [lo, hi] : g ≤ 0 on [start, t] and g falls just after t }
+//! ```
+//!
+//! for otherwise the pair would sink through each other unseen.
 //!
 //! Method. Between consecutive critical points `g` is monotone, so on a piece
 //! `[x₀, x₁]` its extremes are the end values. Walking the pieces in order, the first
@@ -54,6 +62,11 @@ pub(crate) fn first_descent_monotone<T: Real>(
         let g1 = gap(x1);
         if super::is_nan(g0) || super::is_nan(g1) {
             return None;
+        }
+        if !armed && g0 <= T::zero() && g1 < g0 {
+            // Never apart, and closing again: it turned back before it separated (see
+            // `Quadratic::first_descent`); the contact is where it turned.
+            return Some(Descent::At(x0));
         }
         if armed && g1 < T::zero() {
             if g0 <= T::zero() {

@@ -23,12 +23,16 @@ pub(crate) use sphere::SphereGap;
 use carom_math::Real;
 
 /// Whether a gap that is `<= 0` at time 0 is closing, from its value, rate and second
-/// derivative: a negative rate, or (strictly overlapping) a zero rate with a negative
-/// second derivative. Touching with a zero rate is resting contact: not closing.
+/// derivative: a negative rate, or a zero rate with a negative second derivative (the
+/// gap goes negative at once). Touching with zero rate and curvature (resting contact
+/// whose pressing the caller has cancelled) or a positive curvature (a graze) is not.
+///
+/// A ball set down at rest on a floor under gravity is closing: it was once taken for
+/// resting contact, the gap's descent at 0 was not armed (never positive), and the
+/// ball fell through the floor unseen.
 #[inline]
 pub(crate) fn closing<T: Real>(gap: T, rate: T, curvature: T) -> bool {
-    gap <= T::zero()
-        && (rate < T::zero() || (rate == T::zero() && gap < T::zero() && curvature < T::zero()))
+    gap <= T::zero() && (rate < T::zero() || (rate == T::zero() && curvature < T::zero()))
 }
 
 /// `true` for NaN (the one value not ordered against itself).

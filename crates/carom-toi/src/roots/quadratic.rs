@@ -148,9 +148,38 @@ impl<T: Real> Quadratic<T> {
         if armed && at_lo < T::zero() && self.rate(lo) < T::zero() {
             return Descent::At(lo);
         }
+        if !armed
+            && at_lo <= T::zero()
+            && let Some(turn) = self.turn_while_overlapping(lo, hi)
+        {
+            return Descent::At(turn);
+        }
         Descent::Clear {
             armed: armed || at_lo > T::zero() || self.max_after(lo, hi) > T::zero(),
         }
+    }
+
+    /// For a function never positive since time 0 and not positive at `lo`: the first
+    /// time in `[lo, hi]` it stops rising while still not positive (its maximum, or `lo`
+    /// if it falls there), after which it falls.
+    ///
+    /// A pair that starts overlapping and separating must be allowed to separate without
+    /// colliding, but under an acceleration that pulls it back it may turn before it is
+    /// apart: a ball set down on a tilted face overlapping it by a rounding (1e-14 m)
+    /// and leaving it at a rounding (4e-16 m/s) turns back at once. Waiting for a
+    /// separation that never comes, it fell through the face. Its contact is where it
+    /// turns.
+    fn turn_while_overlapping(&self, lo: T, hi: T) -> Option<T> {
+        if self.rate(lo) < T::zero() {
+            return Some(lo);
+        }
+        if self.a < T::zero() {
+            let vertex = -self.h / self.a;
+            if vertex <= hi && self.eval(vertex) <= T::zero() {
+                return Some(vertex.max(lo));
+            }
+        }
+        None
     }
 
     /// The largest value on `(lo, hi]` (`+∞` if it grows without bound), at the end or at
@@ -238,11 +267,8 @@ mod tests {
             q.first_descent(0.0, 0.5, false),
             Descent::Clear { armed: true }
         ));
-        // Starting at the root, unarmed: no descent (it was never positive before).
-        assert!(matches!(
-            q.first_descent(1.0, 2.0, false),
-            Descent::Clear { armed: false }
-        ));
+        // Starting at the root, unarmed and falling: it turns there.
+        assert!(matches!(q.first_descent(1.0, 2.0, false), Descent::At(t) if t == 1.0));
         assert!(matches!(q.first_descent(1.0, 2.0, true), Descent::At(t) if t == 1.0));
         // Rising part only: arms at the end.
         assert!(matches!(
@@ -252,6 +278,27 @@ mod tests {
         assert!(matches!(
             q.first_descent(2.0, 2.5, false),
             Descent::Clear { armed: false }
+        ));
+    }
+
+    #[test]
+    fn an_overlap_that_turns_back_before_it_opens_descends_at_the_turn() {
+        // −(t − 1)² − 1: rising to −1 at t = 1, never positive; unarmed, it turns at 1.
+        let q = Quadratic::new(-1.0, 1.0, -2.0);
+        assert!(matches!(q.first_descent(0.0, 3.0, false), Descent::At(t) if t == 1.0));
+        // The turn after the horizon: nothing yet.
+        assert!(matches!(
+            q.first_descent(0.0, 0.5, false),
+            Descent::Clear { armed: false }
+        ));
+        // −(t − 1)² + 1 opens at 0 and closes at its descending root 2, not at the turn.
+        let q = Quadratic::new(-1.0, 1.0, 0.0);
+        assert!(matches!(q.first_descent(0.0, 3.0, false), Descent::At(t) if t == 2.0));
+        // A convex overlap that keeps opening never turns: open by t = 2 (t² + 2t − 4 = 4).
+        let q = Quadratic::new(1.0, 1.0, -4.0);
+        assert!(matches!(
+            q.first_descent(0.0, 2.0, false),
+            Descent::Clear { armed: true }
         ));
     }
 }
