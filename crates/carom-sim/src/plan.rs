@@ -3,9 +3,10 @@
 //! `carom run` lets the user force an engine, an integrator, a step or a broad phase;
 //! everything left on `auto` is decided here from the scene. The rule for the engine:
 //! the exact event-driven engine whenever the scene can be simulated exactly, the
-//! time-stepped engine otherwise (drag; stuck clusters in 3D, whose torque-free
-//! tumbling has no closed form the event engine could use, or under gravity, against
-//! boxes or in a periodic border), or when the user asks for an integrator or a step.
+//! time-stepped engine otherwise (drag; balls that start stacked on each other under
+//! gravity, a sustained contact; stuck clusters in 3D, whose torque-free tumbling has no
+//! closed form the event engine could use, or under gravity, against boxes or in a
+//! periodic border), or when the user asks for an integrator or a step.
 //! The stepped engine runs every scene the format allows. The engine then builds only the parts the scene uses and
 //! names them in [`Simulation::pipeline`](crate::Simulation::pipeline).
 
@@ -16,7 +17,7 @@ use carom_integrate::Integrator;
 use carom_math::Real;
 
 use crate::engine::EngineKind;
-use crate::scene::{Inelastic, Scene};
+use crate::scene::{Inelastic, OVERLAP_TOLERANCE, Scene};
 
 /// The `--engine` choice.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -126,6 +127,11 @@ pub fn event_engine_limitation<T: Real, const D: usize>(
     if scene.world.drag > T::zero() {
         return Some("the scene has drag, which has no exact time of impact");
     }
+    if starts_pressed_together(scene) {
+        return Some(
+            "balls start pressed together under gravity (a stack or a pile: sustained contact, which no finite sequence of exact events resolves)",
+        );
+    }
     if can_stick(scene) {
         if D == 3 {
             return Some(
@@ -145,6 +151,28 @@ pub fn event_engine_limitation<T: Real, const D: usize>(
         }
     }
     None
+}
+
+/// Whether two balls of `scene` start touching (within the scene format's overlap
+/// tolerance) along a line that gravity does not cross at right angles: one rests on
+/// the other, and the event engine would meet that contact again and again at one
+/// instant. (Balls touching side by side, level under gravity, do not press.)
+pub fn starts_pressed_together<T: Real, const D: usize>(scene: &Scene<T, D>) -> bool {
+    let g = scene.world.gravity;
+    let g_norm = g.norm();
+    if g_norm == T::zero() {
+        return false;
+    }
+    let tol = T::lit(OVERLAP_TOLERANCE);
+    scene
+        .find_near_pair(|_, _, offset, gap| {
+            // |cos| of the angle between the line of centres and gravity: level pairs
+            // (to 1e-6 rad) are not pressed.
+            let pressed =
+                gap <= tol && offset.dot(&g).abs() > T::lit(1e-6) * offset.norm() * g_norm;
+            pressed.then_some(())
+        })
+        .is_some()
 }
 
 /// Whether two balls of `scene` can stick: `inelastic = "stick"` and some ball's
@@ -308,6 +336,7 @@ pub fn plan<T: Real, const D: usize>(
 mod tests {
     use super::*;
     use crate::scenes::classic;
+    use nalgebra::Vector2;
 
     #[test]
     fn auto_picks_the_exact_engine_unless_the_scene_or_the_user_needs_steps() {
@@ -329,6 +358,56 @@ mod tests {
         let p = plan(&s, &RunOptions::default()).unwrap();
         assert_eq!(p.engine, EngineKind::Stepped);
         assert_eq!(p.integrator, Some(Integrator::SemiImplicitEuler));
+    }
+
+    #[test]
+    fn balls_stacked_under_gravity_go_to_the_stepped_engine_and_level_ones_do_not() {
+        // Two touching balls: ball 1 at angle θ from ball 0, gravity straight down.
+        let pair = |angle: f64, gap: f64| {
+            let mut s = classic::head_on(1.0, 1.0, 0.0, 0.0, 1.0);
+            let d = 2.0 * s.balls[0].radius + gap;
+            s.balls[1].pos = s.balls[0].pos + Vector2::new(angle.cos(), angle.sin()) * d;
+            s.world.gravity = Vector2::new(0.0, -9.81);
+            s
+        };
+        let auto = RunOptions::default();
+        let stacked = plan(&pair(1.2, 0.0), &auto).unwrap();
+        assert_eq!(stacked.engine, EngineKind::Stepped);
+        assert!(
+            stacked.reason.contains("pressed together"),
+            "{}",
+            stacked.reason
+        );
+        // Within the overlap the format allows, and 5e-10 m apart: still pressed.
+        assert_eq!(
+            plan(&pair(0.3, -1e-9), &auto).unwrap().engine,
+            EngineKind::Stepped
+        );
+        assert_eq!(
+            plan(&pair(0.3, 5e-10), &auto).unwrap().engine,
+            EngineKind::Stepped
+        );
+        // Level, or a hair more than the tolerance apart, or without gravity: exact.
+        assert_eq!(
+            plan(&pair(0.0, 0.0), &auto).unwrap().engine,
+            EngineKind::Event
+        );
+        assert_eq!(
+            plan(&pair(0.3, 1e-8), &auto).unwrap().engine,
+            EngineKind::Event
+        );
+        let mut weightless = pair(1.2, 0.0);
+        weightless.world.gravity = Vector2::zeros();
+        assert_eq!(plan(&weightless, &auto).unwrap().engine, EngineKind::Event);
+        let forced = RunOptions {
+            engine: EngineChoice::Event,
+            ..RunOptions::default()
+        };
+        let e = plan(&pair(1.2, 0.0), &forced).unwrap_err();
+        assert!(
+            e.0.starts_with("--engine event: balls start pressed together"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -53,6 +53,52 @@ fn auto_chooses_the_stepped_engine_for_drag_and_builds_it() {
     }
 }
 
+/// Three balls set down stacked on the floor: `auto` sends them to the stepped engine
+/// (the event engine cannot resolve sustained contact), which keeps the stack standing
+/// for a second.
+#[test]
+fn auto_sends_a_stack_under_gravity_to_the_stepped_engine_which_keeps_it_standing() {
+    let r = 0.1;
+    let s = Scene {
+        name: None,
+        world: World {
+            gravity: Vector2::new(0.0, -9.81),
+            restitution: 0.5,
+            border: Some(BorderSpec {
+                border: Border::new(Vector2::new(-1.0, 0.0), Vector2::new(1.0, 2.0)).unwrap(),
+                restitution: 0.5,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls: (0..3)
+            .map(|k| {
+                BallSpec::new(
+                    Vector2::new(0.0, r * f64::from(2 * k + 1)),
+                    Vector2::zeros(),
+                    r,
+                    1.0,
+                )
+            })
+            .collect(),
+        boxes: Vec::new(),
+    };
+    let p = plan(&s, &RunOptions::default()).unwrap();
+    assert_eq!(p.engine, EngineKind::Stepped);
+    assert!(p.reason.contains("pressed together"), "{}", p.reason);
+    let mut sim = build(&s, &p, Direction::Forward).unwrap();
+    sim.advance_to(1.0, &mut ()).unwrap();
+    let mut st = BallStates::default();
+    sim.states(&mut st);
+    for (k, pos) in st.pos.iter().enumerate() {
+        let height = r * f64::from(2 * k as u32 + 1);
+        assert!(
+            (pos - Vector2::new(0.0, height)).norm() < 1e-3,
+            "ball {k} at {pos:?}"
+        );
+    }
+}
+
 #[test]
 fn the_broad_phase_is_chosen_from_the_scene_and_refused_where_it_cannot_work() {
     let small = classic::head_on(1.0, 1.0, 1.0, -1.0, 1.0);

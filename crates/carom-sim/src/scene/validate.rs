@@ -155,36 +155,52 @@ impl<T: Real, const D: usize> Scene<T, D> {
     /// periodic box). Candidate pairs come from a carom-broad uniform grid, so large
     /// scenes are checked in about linear time.
     fn validate_ball_overlaps(&self) -> Result<(), SceneError> {
+        let tol = T::lit(OVERLAP_TOLERANCE);
+        self.find_near_pair(|i, j, _, gap| {
+            (-gap > tol).then(|| {
+                SceneError::new(
+                    format!("balls[{j}].pos"),
+                    format!(
+                        "overlaps balls[{i}] by {:.3e} m at the start (at most 1e-9 m is allowed)",
+                        (-gap).to_f64()
+                    ),
+                )
+            })
+        })
+        .map_or(Ok(()), Err)
+    }
+
+    /// The first answer `found(i, j, offset, gap)` gives for a pair of balls `i < j`
+    /// at most [`OVERLAP_TOLERANCE`] apart (and perhaps some farther), with `offset` from
+    /// `i` to `j` (the minimum image in a periodic box) and `gap` the distance between
+    /// their surfaces (negative when they overlap).
+    pub(crate) fn find_near_pair<R>(
+        &self,
+        mut found: impl FnMut(usize, usize, Vector<T, D>, T) -> Option<R>,
+    ) -> Option<R> {
         if self.balls.len() < 2 {
-            return Ok(());
+            return None;
         }
         let centers: Vec<Vector<T, D>> = self.balls.iter().map(|b| b.pos).collect();
-        let radii: Vec<T> = self.balls.iter().map(|b| b.radius).collect();
+        // The grid pairs overlapping balls: each grown by the tolerance so that balls
+        // that far apart are among them.
+        let reach = T::lit(OVERLAP_TOLERANCE);
+        let grown: Vec<T> = self.balls.iter().map(|b| b.radius + reach).collect();
         let periodic = self.world.border.filter(|b| b.periodic).map(|b| b.border);
         let mut grid = match periodic {
             Some(border) => UniformGrid::periodic(border),
             None => UniformGrid::hashed(),
         };
-        grid.update(Balls::new_unchecked(&centers, &radii).into());
+        grid.update(Balls::new_unchecked(&centers, &grown).into());
         let mut pairs = Vec::new();
         grid.pairs(&mut pairs);
-        let tol = T::lit(OVERLAP_TOLERANCE);
-        for &(i, j) in &pairs {
-            let (i, j) = (i as usize, j as usize);
+        pairs.into_iter().find_map(|(i, j)| {
+            let (i, j) = (i.min(j) as usize, i.max(j) as usize);
             let d = centers[j] - centers[i];
             let d = periodic.map_or(d, |b| b.minimum_image(&d));
-            let overlap = radii[i] + radii[j] - d.norm();
-            if overlap > tol {
-                return Err(SceneError::new(
-                    format!("balls[{j}].pos"),
-                    format!(
-                        "overlaps balls[{i}] by {:.3e} m at the start (at most 1e-9 m is allowed)",
-                        overlap.to_f64()
-                    ),
-                ));
-            }
-        }
-        Ok(())
+            let gap = d.norm() - self.balls[i].radius - self.balls[j].radius;
+            found(i, j, d, gap)
+        })
     }
 
     /// No ball overlaps a box by more than [`OVERLAP_TOLERANCE`] at the start.
