@@ -238,6 +238,9 @@ where
     counters: Counters,
     /// Events processed at the current instant, to detect a cascade that never ends.
     events_at_instant: usize,
+    /// The last pair of balls found resting on each other and when (a second such
+    /// collision of the pair at a later time ends the run: sustained contact).
+    resting_pair: Option<(usize, usize, T)>,
     /// The most events at one instant before a cascade is declared endless.
     events_allowed_at_one_instant: usize,
     pipeline: Vec<String>,
@@ -354,6 +357,7 @@ where
             now: T::zero(),
             counters: Counters::default(),
             events_at_instant: 0,
+            resting_pair: None,
             events_allowed_at_one_instant: events_allowed_at_one_instant(
                 scene.balls.iter().map(|b| b.mass),
             ),
