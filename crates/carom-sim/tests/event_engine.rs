@@ -831,6 +831,61 @@ fn a_stack_of_balls_under_gravity_is_refused_with_a_clear_error() {
     );
 }
 
+/// A kinematic box driving a ball resting in a corner of the room into that corner is a
+/// crush, which no finite sequence of events resolves: the run ends as a cascade when
+/// the box's face reaches the ball (t = 0.4 s), near the origin and 5e4 m from it.
+/// (5e4 m away the code before ended it at t = 0, the ball set down in the corner; a
+/// fuzzed crush there crept on at one event every 1e-14 s, later than the last, until
+/// events closer than the positions can tell apart counted as one instant.)
+#[test]
+fn a_ball_crushed_into_a_corner_by_a_moving_box_ends_as_a_cascade_when_the_box_arrives() {
+    for offset in [0.0, -5e4] {
+        let low = offset - 0.5;
+        let scene = Scene {
+            name: None,
+            world: World {
+                gravity: Vector2::new(0.0, -9.81),
+                border: Some(BorderSpec {
+                    border: Border::new(
+                        Vector2::new(low, low),
+                        Vector2::new(offset + 0.5, offset + 0.5),
+                    )
+                    .unwrap(),
+                    restitution: 0.5,
+                    periodic: false,
+                }),
+                ..World::default()
+            },
+            balls: vec![BallSpec::new(
+                Vector2::new(low + 0.02, low + 0.02),
+                Vector2::zeros(),
+                0.02,
+                1.0,
+            )],
+            boxes: vec![BoxSpec {
+                shape: Obb::from_angle(
+                    Vector2::new(low + 0.3, low + 0.25),
+                    Vector2::new(0.1, 0.05),
+                    0.0,
+                )
+                .unwrap(),
+                vel: Vector2::new(-0.4, -0.5),
+                restitution: 1.0,
+            }],
+        };
+        let mut sim =
+            EventEngine::new(&scene, &plan(BroadChoice::Auto), Direction::Forward).unwrap();
+        let err = sim.advance_to(2.0, &mut ()).unwrap_err();
+        assert!(err.message.contains("cascade"), "{}", err.message);
+        // The box's left face reaches the ball's right side: 0.16 m at 0.4 m/s.
+        assert!(
+            (err.time - 0.4).abs() < 1e-6,
+            "at {offset}: ended at {}",
+            err.time
+        );
+    }
+}
+
 #[test]
 fn f32_runs_keep_balls_apart_and_conserve_energy_to_single_precision() {
     let scene = gas::<2>(&GasParams {
