@@ -754,7 +754,7 @@ proptest! {
         let scale = 1.0 + centre.norm();
         // A ball that reaches the face's end sooner than the resting guard's shortest
         // flight is not held by the face: it hops along it, leaving at the speed that
-        // lifts it above the resolution of its position, √(2 g · 8u|x|).
+        // lifts it above the resolution of its position, √(2 g · 8ε|x|).
         let lift = (2.0 * g * 8.0 * f64::EPSILON * (scale + 10.0)).sqrt();
         prop_assert!(
             (st.pos[0] - expected).norm() < 1e-9 * scale + lift * tau,

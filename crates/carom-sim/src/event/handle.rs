@@ -17,7 +17,7 @@ use carom_response::{
 use nalgebra::Const;
 
 use super::state::{Mode, Support};
-use super::{EventEngine, Partners, Pending};
+use super::{EventEngine, Partners, Pending, coordinate_resolution};
 use crate::engine::{Collision, Observer, SimError};
 
 impl<T: Real, const D: usize> EventEngine<T, D>
@@ -84,7 +84,9 @@ where
                     // Read before the impulse frees a ball resting on a surface.
                     let pressing = self.pair_pressing(i, j);
                     self.collide_balls(i, j, observer);
-                    self.refuse_resting_pair(i, j, pressing)?;
+                    if let Some(pressing) = pressing {
+                        self.refuse_resting_pair(i, j, pressing)?;
+                    }
                     self.predict(i);
                     self.predict(j);
                 }
@@ -245,26 +247,26 @@ where
         });
     }
 
-    /// How hard gravity presses touching balls `i` and `j` together: minus the
-    /// acceleration of their gap along the line of centres (`0` without gravity). Not
-    /// zero only when one rests on a surface, its weight cancelled, and the other does
-    /// not.
-    fn pair_pressing(&self, i: usize, j: usize) -> T {
+    /// How hard gravity presses touching balls `i` and `j` together, with the unit
+    /// normal from `i` to `j`: minus the acceleration of their gap along the line of
+    /// centres. `None` unless it presses: without gravity, or unless one rests on a
+    /// surface, its weight cancelled, and the other does not.
+    fn pair_pressing(&self, i: usize, j: usize) -> Option<(T, Vector<T, D>)> {
         if !self.balls.accelerated {
-            return T::zero();
+            return None;
         }
         let normal = self
             .separation(
                 &self.balls.position_at(i, self.now),
                 &self.balls.position_at(j, self.now),
             )
-            .try_normalize(T::zero())
-            .unwrap_or_else(Vector::zeros);
-        -(self.balls.accel(j) - self.balls.accel(i)).dot(&normal)
+            .try_normalize(T::zero())?;
+        let pressing = -(self.balls.accel(j) - self.balls.accel(i)).dot(&normal);
+        (pressing > T::zero()).then_some((pressing, normal))
     }
 
     /// An error if balls `i` and `j`, just resolved while gravity pressed them together
-    /// at `pressing` ([`EventEngine::pair_pressing`]), part too slowly for the resting
+    /// along `normal` ([`EventEngine::pair_pressing`]), part too slowly for the resting
     /// guard's shortest flight a second time, later than the first: they rest on each
     /// other. That is sustained contact, which this engine cannot resolve: it has no
     /// resting state on a ball, and the pair hopped forever (fuzzed: a 900 kg ball
@@ -272,27 +274,23 @@ where
     /// every 2.4 ns, a crawl that never ended). A slow parting within one instant is
     /// not enough: a heavy ball pressing a light one into the floor parts slowly many
     /// times in the cascade that turns it back, and the run goes on.
-    fn refuse_resting_pair(&mut self, i: usize, j: usize, pressing: T) -> Result<(), SimError> {
-        if pressing <= T::zero() {
-            return Ok(());
-        }
-        let offset = self.separation(&self.balls.motion[i].pos, &self.balls.motion[j].pos);
-        let Some(normal) = offset.try_normalize(T::zero()) else {
-            return Ok(());
-        };
+    fn refuse_resting_pair(
+        &mut self,
+        i: usize,
+        j: usize,
+        (pressing, normal): (T, Vector<T, D>),
+    ) -> Result<(), SimError> {
         let parting = (self.balls.motion[j].vel - self.balls.motion[i].vel).dot(&normal);
         let pair = (i.min(j), i.max(j));
+        let seen = self.resting_pair.filter(|(p, _)| *p == pair);
         if self.resting.decide(parting, T::one(), pressing) == Bounce::Rebound {
-            if self.resting_pair.is_some_and(|(a, b, _)| (a, b) == pair) {
+            if seen.is_some() {
                 self.resting_pair = None;
             }
             return Ok(());
         }
-        let again = self
-            .resting_pair
-            .is_some_and(|(a, b, t)| (a, b) == pair && t < self.now);
-        if !again {
-            self.resting_pair = Some((pair.0, pair.1, self.now));
+        if !seen.is_some_and(|(_, t)| t < self.now) {
+            self.resting_pair = Some((pair, self.now));
             return Ok(());
         }
         Err(SimError {
@@ -370,9 +368,8 @@ where
         let approach = -normal_velocity(&a, &b, &contact);
         let mut e = self.surface_restitution(i, surface_restitution);
         let pressing = self.gravity.dot(&normal);
-        // The heights the ball's position can resolve: a few roundings of its largest
-        // coordinate (as a prediction's reach).
-        let resolution = T::lit(8.0) * T::EPSILON * self.balls.motion[i].pos.amax();
+        // The heights the ball's position can resolve.
+        let resolution = coordinate_resolution(self.balls.motion[i].pos.amax());
         let rest = self
             .resting
             .decide_resolved(approach, e, pressing, resolution)
@@ -391,7 +388,7 @@ where
         // (`part_by_rounding`; the surface is a body of no inverse mass), and, pressed
         // onto the surface, fast enough to rise above the resolution of the position,
         // unless it rests. A ball rebounding from a box's edge at the resolution of its
-        // velocity flew 1e-15 s, too short for its position (at x = 431 m) to move: it
+        // velocity flew 3.4e-15 s, too short for its position (at x = 431 m) to move: it
         // met the same edge again and again while the clock crept on (a ball sliding
         // off a face at 9 m/s, forever). Rising `resolution` under `g_n` takes
         // `√(2 g_n resolution)`.
@@ -523,8 +520,8 @@ fn parting_shortfall<T: Real, const D: usize>(
     (shortfall > T::zero()).then_some(shortfall)
 }
 
-/// The resolution of a contact's normal relative velocity: `8 u (|v_a| + |v_b|)` (`u`
-/// the unit roundoff), eight roundings of the largest terms the relative velocity and
+/// The resolution of a contact's normal relative velocity: `8 ε (|v_a| + |v_b|)` (`ε`
+/// the machine epsilon, two unit roundoffs), sixteen roundings of the largest terms the relative velocity and
 /// its normal component are computed from, in whatever frame (the prediction computes
 /// a box contact's in the box's). A pair separating at least this fast is separating
 /// however its normal velocity is computed, and a velocity change this large along a

@@ -241,9 +241,10 @@ where
     /// Events closer than this to the one before belong to the same instant
     /// ([`instant_width`]).
     instant_width: T,
-    /// The last pair of balls found resting on each other and when (a second such
-    /// collision of the pair at a later time ends the run: sustained contact).
-    resting_pair: Option<(usize, usize, T)>,
+    /// The last pair of balls `(i, j)`, `i < j`, found resting on each other and when
+    /// (a second such collision of the pair at a later time ends the run: sustained
+    /// contact).
+    resting_pair: Option<((usize, usize), T)>,
     /// The most events at one instant before a cascade is declared endless.
     events_allowed_at_one_instant: usize,
     pipeline: Vec<String>,
@@ -360,7 +361,7 @@ where
             now: T::zero(),
             counters: Counters::default(),
             events_at_instant: 0,
-            instant_width: instant_width(scene),
+            instant_width: instant_width(scene, length_scale(scene)),
             resting_pair: None,
             events_allowed_at_one_instant: events_allowed_at_one_instant(
                 scene.balls.iter().map(|b| b.mass),
@@ -681,27 +682,34 @@ where
     }
 }
 
-/// The size of a scene: the largest border extent, or the spread of the balls.
 /// How close in time two events must be to count as one instant: the time the fastest
-/// body of the scene takes to move by the resolution of its positions, `8 u X / V`
-/// (`X` the [`length_scale`], `V` the largest initial ball or box speed or the speed
-/// of a fall through `X`). Positions cannot tell such events apart: a ball crushed into
-/// a corner by a kinematic box 5e4 m from the origin was struck every 1e-14 s, each
-/// event a little later than the last, and the run crept on forever instead of ending
-/// as the cascade it is.
-fn instant_width<T: Real, const D: usize>(scene: &Scene<T, D>) -> T {
-    let x = length_scale(scene);
+/// body of the scene takes to move by the resolution of its coordinates,
+/// [`coordinate_resolution`]`(X) / V` (`X` the scene's [`length_scale`], `V` the largest
+/// initial ball or box speed or the speed of a fall through `X`). Positions cannot tell
+/// such events apart: a ball crushed into a corner by a kinematic box 5e4 m from the
+/// origin was struck every 1e-14 s, each event a little later than the last, and the
+/// run crept on forever instead of ending as the cascade it is.
+fn instant_width<T: Real, const D: usize>(scene: &Scene<T, D>, length_scale: T) -> T {
     let speed = scene
         .balls
         .iter()
         .map(|b| b.vel.norm())
         .chain(scene.boxes.iter().map(|b| b.vel.norm()))
         .fold(T::zero(), T::max)
-        .max((T::lit(2.0) * scene.world.gravity.norm() * x).sqrt());
-    let width = T::lit(8.0) * T::EPSILON * x / speed;
+        .max((T::lit(2.0) * scene.world.gravity.norm() * length_scale).sqrt());
+    let width = coordinate_resolution(length_scale) / speed;
     if width.finite() { width } else { T::zero() }
 }
 
+/// The resolution of a coordinate of magnitude `x`: `8 ε x` (`ε` the machine epsilon,
+/// two unit roundoffs), sixteen roundings. A length or a rise below it is not seen by
+/// positions of that size (the resting guard's height floor, the lift of a bounce, the
+/// width of an instant).
+pub(crate) fn coordinate_resolution<T: Real>(x: T) -> T {
+    T::lit(8.0) * T::EPSILON * x
+}
+
+/// The size of a scene: the largest border extent, or the spread of the balls.
 fn length_scale<T: Real, const D: usize>(scene: &Scene<T, D>) -> T {
     let spread = scene
         .balls

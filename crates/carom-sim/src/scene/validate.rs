@@ -195,7 +195,7 @@ impl<T: Real, const D: usize> Scene<T, D> {
         let mut pairs = Vec::new();
         grid.pairs(&mut pairs);
         pairs.into_iter().find_map(|(i, j)| {
-            let (i, j) = (i.min(j) as usize, i.max(j) as usize);
+            let (i, j) = (i as usize, j as usize);
             let d = centers[j] - centers[i];
             let d = periodic.map_or(d, |b| b.minimum_image(&d));
             let gap = d.norm() - self.balls[i].radius - self.balls[j].radius;

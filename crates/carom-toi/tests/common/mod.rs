@@ -12,21 +12,26 @@ pub fn brute_first_descent(gap: impl Fn(f64) -> f64, horizon: f64, samples: usiz
         let t = horizon * i as f64 / samples as f64;
         let g = gap(t);
         if armed && g < 0.0 {
-            let (mut lo, mut hi) = (prev, t);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if gap(mid) < 0.0 {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            return Some(lo);
+            return Some(last_apart(&gap, prev, t));
         }
         armed |= g > 0.0;
         prev = t;
     }
     None
+}
+
+/// The last time in `[lo, hi]` the gap is not negative, given `gap(lo) >= 0 > gap(hi)`
+/// (60 halvings).
+fn last_apart(gap: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if gap(mid) < 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    lo
 }
 
 /// The first contact in `(0, horizon]` by carom-toi's definition, sampled as
@@ -45,16 +50,7 @@ pub fn brute_first_contact(
         let t = horizon * i as f64 / samples as f64;
         let g = gap(t);
         if armed && g < 0.0 {
-            let (mut lo, mut hi) = (prev, t);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if gap(mid) < 0.0 {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            return Some((lo, false));
+            return Some((last_apart(&gap, prev, t), false));
         }
         if !armed && g <= 0.0 && g < prev_gap - 1e-12 {
             // The maximum lies in [before, t].
