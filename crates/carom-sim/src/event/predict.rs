@@ -35,7 +35,7 @@ where
         let ball = self.ball_at(i, self.now);
         let kin =
             Kinematics::new_unchecked(self.balls.velocity_at(i, self.now), self.balls.accel(i));
-        self.offer_surfaces(&ball, &kin, self.support_box(i), &mut best);
+        self.offer_surfaces(i, &ball, &kin, &mut best);
         if !self.clusters.is_empty() {
             self.predict_ball_vs_clusters(i, &mut best.time, &mut best.pending);
         }
@@ -125,8 +125,8 @@ where
         }
     }
 
-    /// The first contact of a ball with a border wall or a box other than `support` (the
-    /// box it rests on).
+    /// The first contact of ball `i` (`ball`, moving with `kin`) with a border wall or a
+    /// box other than the one it rests on.
     ///
     /// A ball resting on a face of a box cannot meet that box until it leaves the face
     /// (the box is convex), which [`EventEngine::face_exit_time`] schedules. Asked, the
@@ -136,9 +136,9 @@ where
     /// event came due forever.
     fn offer_surfaces(
         &self,
+        i: usize,
         ball: &Ball<T, D>,
         kin: &Kinematics<T, D>,
-        support: Option<usize>,
         best: &mut Best<T>,
     ) {
         let now = self.now;
@@ -155,6 +155,10 @@ where
                 );
             }
         }
+        if self.boxes.is_empty() {
+            return;
+        }
+        let support = self.support_box(i);
         for (k, b) in self.boxes.iter().enumerate() {
             if support == Some(k) {
                 continue;
