@@ -16,17 +16,11 @@ use std::time::Duration;
 
 use carom::sim::plan::{BroadChoice, Plan};
 use carom::sim::scenes::gas::{GasParams, gas};
-use carom::sim::{EngineKind, EventEngine, Simulation};
+use carom::sim::{EventEngine, Simulation};
 use carom::toi::Direction;
 
 fn plan() -> Plan {
-    Plan {
-        engine: EngineKind::Event,
-        reason: "bench",
-        integrator: None,
-        dt: None,
-        broad: BroadChoice::Auto,
-    }
+    Plan::event(BroadChoice::Auto)
 }
 
 macro_rules! gas_bench {

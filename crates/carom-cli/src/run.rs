@@ -11,7 +11,7 @@ use carom_math::Space;
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions};
 use carom_sim::run::{RunSink, Summary, drive, sample_times};
 use carom_sim::scene::{LoadedScene, Scene, load_scene_file};
-use carom_sim::{BallStates, Collision};
+use carom_sim::{BallStates, Collision, EngineKind};
 use carom_toi::Direction;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -176,6 +176,13 @@ where
         bar.finish_and_clear();
     }
     let summary = summary.map_err(|e| Failure::Run(format!("{label}: simulation failed {e}")))?;
+    if let Some(h) = &summary.hand_over {
+        eprintln!(
+            "carom: note: {label}: at t = {} the run went over from the event engine to the stepped engine: {}",
+            h.time.to_f64(),
+            h.reason
+        );
+    }
     sink.summary(&summary);
     if let Some(e) = sink.error.take() {
         return Err(Failure::Run(format!("writing the output: {e}")));
@@ -207,7 +214,17 @@ impl JsonSink {
     fn summary<T: JsonFloat, const D: usize>(&mut self, s: &Summary<T, D>) {
         let l = &mut self.line;
         l.push_str("{\"summary\": {\"engine\": ");
-        json::string(l, &s.engine.to_string());
+        match &s.hand_over {
+            None => json::string(l, &s.engine.to_string()),
+            Some(_) => json::string(l, &format!("{}+{}", EngineKind::Event, s.engine)),
+        }
+        if let Some(h) = &s.hand_over {
+            l.push_str(", \"hand_over\": {\"t\": ");
+            h.time.write_json(l);
+            l.push_str(", \"reason\": ");
+            json::string(l, &h.reason);
+            l.push('}');
+        }
         l.push_str(", \"pipeline\": [");
         for (k, p) in s.pipeline.iter().enumerate() {
             if k > 0 {

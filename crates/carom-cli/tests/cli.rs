@@ -1,7 +1,8 @@
 //! `carom run` against its contract (docs/scene-format.md): output lines, exit statuses,
 //! one-line errors naming the file and the field.
 
-use std::path::PathBuf;
+use std::ops::Deref;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use serde_json::Value;
@@ -13,13 +14,28 @@ fn carom(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-/// Writes `text` to a fresh scene file and returns its path.
-fn scene_file(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("carom-cli-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
+/// A scene file in a directory of its own, removed when the value is dropped.
+struct SceneFile {
+    path: PathBuf,
+    _dir: tempfile::TempDir,
+}
+
+impl Deref for SceneFile {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.path
+    }
+}
+
+/// Writes `text` to a fresh scene file.
+fn scene_file(name: &str, text: &str) -> SceneFile {
+    let dir = tempfile::Builder::new()
+        .prefix("carom-cli-test-")
+        .tempdir()
+        .unwrap();
+    let path = dir.path().join(name);
     std::fs::write(&path, text).unwrap();
-    path
+    SceneFile { path, _dir: dir }
 }
 
 const INTRO: &str = r#"
@@ -290,6 +306,68 @@ mass = 2.0
         let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
         assert!((d - 0.25).abs() < 1e-9, "{d}");
     }
+}
+
+/// Two balls dropped one above the other settle into a pile: sustained contact, which
+/// the event engine cannot resolve. `auto` hands the run over to the stepped engine and
+/// says so (summary and stderr); `--engine event` stops with status 1 and the reason.
+#[test]
+fn auto_hands_a_pile_over_to_the_stepped_engine_and_says_so() {
+    let path = scene_file(
+        "pile.toml",
+        "dim = 2
+[world]
+gravity = [0.0, -9.81]
+restitution = 0.5
+[world.border]
+min = [-1.0, 0.0]
+max = [1.0, 3.0]
+restitution = 0.5
+[[balls]]
+pos = [0.0, 0.5]
+radius = 0.1
+mass = 1.0
+[[balls]]
+pos = [0.0, 1.2]
+radius = 0.1
+mass = 1.0
+",
+    );
+    let file = path.to_str().unwrap();
+    let out = carom(&["run", file, "--until", "3", "--events"]);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let lines = lines(&out);
+    let summary = &lines.last().unwrap()["summary"];
+    assert_eq!(summary["engine"], "event+stepped", "{summary}");
+    let t = summary["hand_over"]["t"].as_f64().unwrap();
+    assert!(t > 0.5 && t < 1.5, "{summary}");
+    let reason = summary["hand_over"]["reason"].as_str().unwrap();
+    assert!(reason.contains("sustained contact"), "{reason}");
+    assert!(
+        stderr.contains("went over from the event engine to the stepped engine"),
+        "{stderr}"
+    );
+    // The pile stands at heights 0.1 and 0.3.
+    let end = &lines[lines.len() - 2];
+    assert_eq!(end["t"], 3.0);
+    for (i, height) in [0.1, 0.3].into_iter().enumerate() {
+        let y = end["pos"][i][1].as_f64().unwrap();
+        assert!((y - height).abs() < 1e-8, "ball {i} at {y}");
+    }
+    // Event lines keep one clock across the hand-over.
+    let times: Vec<f64> = lines
+        .iter()
+        .filter_map(|l| l["event"].as_str().and(l["t"].as_f64()))
+        .collect();
+    assert!(times.windows(2).all(|w| w[0] <= w[1]), "{times:?}");
+
+    let forced = carom(&["run", file, "--until", "3", "--engine", "event"]);
+    assert_eq!(forced.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&forced.stderr);
+    assert!(
+        err.contains("sustained contact") && err.contains("--engine auto"),
+        "{err}"
+    );
 }
 
 /// The stderr of a run that must fail with status 2 (bad flags).

@@ -255,9 +255,11 @@ mod tests {
 
     #[test]
     fn a_chart_becomes_an_svg_with_its_labels() {
-        let dir = std::env::temp_dir().join(format!("carom-plot-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("chart.svg");
+        let dir = tempfile::Builder::new()
+            .prefix("carom-plot-")
+            .tempdir()
+            .unwrap();
+        let path = dir.path().join("chart.svg");
         let chart = Chart {
             title: "ms per step".into(),
             x_label: "balls".into(),

@@ -24,7 +24,7 @@ use carom_sim::plan::{BroadChoice, EngineChoice, Plan, RunOptions, plan};
 use carom_sim::scene::Scene;
 use carom_sim::scenes::gas::{GasParams, gas};
 use carom_sim::stepped::SteppedEngine;
-use carom_sim::{BallStates, EngineKind, EventEngine, Simulation, observe};
+use carom_sim::{BallStates, EventEngine, Simulation, observe};
 use carom_toi::Direction;
 use nalgebra::Const;
 
@@ -223,13 +223,7 @@ where
         case: format!("{name} N={n}"),
         message: e.to_string(),
     };
-    let event_plan = Plan {
-        engine: EngineKind::Event,
-        reason: "report",
-        integrator: None,
-        dt: None,
-        broad: BroadChoice::Auto,
-    };
+    let event_plan = Plan::event(BroadChoice::Auto);
     let mut sim =
         EventEngine::new(&scene, &event_plan, Direction::Forward).map_err(|e| case(&e))?;
     let mut states = BallStates::default();

@@ -7,15 +7,15 @@ use carom_report::model::{
 use carom_report::{Config, run_with, summary_table};
 use serde_json::Value;
 
-fn out_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("carom-report-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
-
 #[test]
 fn a_tiny_report_writes_markdown_json_and_plots_that_parse_back() {
-    let dir = out_dir("tiny");
+    // The report creates its directory: hand it one that does not exist yet, inside a
+    // temporary directory removed at the end.
+    let scratch = tempfile::Builder::new()
+        .prefix("carom-report-")
+        .tempdir()
+        .unwrap();
+    let dir = scratch.path().join("tiny");
     let messages = std::cell::RefCell::new(Vec::new());
     let report = run_with(&Config::tiny(), &dir, &|p| {
         assert!(p.done <= p.total);

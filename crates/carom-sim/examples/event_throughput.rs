@@ -22,7 +22,7 @@ use std::time::Instant;
 
 use carom_sim::plan::{BroadChoice, Plan};
 use carom_sim::scenes::gas::{GasParams, gas};
-use carom_sim::{BallStates, EngineKind, EventEngine, PairSearch, Simulation};
+use carom_sim::{BallStates, EventEngine, PairSearch, Simulation};
 use carom_toi::Direction;
 
 fn arg<T: std::str::FromStr>(k: usize, default: T) -> T {
@@ -52,13 +52,7 @@ fn main() {
         periodic: true,
         ..GasParams::default()
     };
-    let plan = Plan {
-        engine: EngineKind::Event,
-        reason: "example",
-        integrator: None,
-        dt: None,
-        broad: BroadChoice::Auto,
-    };
+    let plan = Plan::event(BroadChoice::Auto);
     macro_rules! run {
         ($d:literal) => {{
             let scene = gas::<$d>(&params).unwrap_or_else(|e| panic!("{e}"));

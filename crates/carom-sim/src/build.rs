@@ -6,12 +6,14 @@ use nalgebra::Const;
 
 use crate::engine::{EngineKind, Simulation};
 use crate::event::EventEngine;
+use crate::handover::EventThenStepped;
 use crate::plan::Plan;
 use crate::scene::{Scene, SceneError};
 use crate::stepped::SteppedEngine;
 
 /// The engine `plan` chose for `scene`, running in `direction`, behind the common
-/// [`Simulation`] face.
+/// [`Simulation`] face: the event engine handing over to the stepped one where the plan
+/// says so ([`Plan::hand_over`]).
 ///
 /// # Errors
 /// The scene's [`SceneError`] (every engine validates the scene), or an option the
@@ -25,6 +27,9 @@ where
     Const<D>: Space<T, D>,
 {
     match plan.engine {
+        EngineKind::Event if plan.hand_over => {
+            Ok(Box::new(EventThenStepped::new(scene, plan, direction)?))
+        }
         EngineKind::Event => Ok(Box::new(EventEngine::new(scene, plan, direction)?)),
         EngineKind::Stepped => Ok(Box::new(SteppedEngine::new(scene, plan, direction)?)),
     }

@@ -73,6 +73,23 @@ impl<T: Real> Collision<T> {
             | Collision::BallBox { time, .. } => time,
         }
     }
+
+    /// The same collision `by` later.
+    pub fn shifted(&self, by: T) -> Self {
+        match *self {
+            Collision::BallBall { time, i, j } => Collision::BallBall {
+                time: time + by,
+                i,
+                j,
+            },
+            Collision::BallBorder { time, i } => Collision::BallBorder { time: time + by, i },
+            Collision::BallBox { time, i, k } => Collision::BallBox {
+                time: time + by,
+                i,
+                k,
+            },
+        }
+    }
 }
 
 /// The number of collisions of each kind so far.
@@ -146,7 +163,7 @@ pub trait Observer<T: Real> {
 /// An observer that ignores everything.
 impl<T: Real> Observer<T> for () {}
 
-/// A failure while running: the state is no longer trustworthy, so the run stops.
+/// A failure while running: the engine cannot go on, so the run stops.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("at t = {time}: {message}")]
 pub struct SimError {
@@ -154,6 +171,41 @@ pub struct SimError {
     pub time: f64,
     /// What went wrong.
     pub message: String,
+    /// What kind of failure it is: whether another engine can take the run on.
+    pub kind: SimErrorKind,
+}
+
+/// What kind of failure a [`SimError`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimErrorKind {
+    /// The engine cannot continue this run (the message says why).
+    Failed,
+    /// Bodies came to press on each other under gravity (a stack, a pile, a wedge):
+    /// sustained contact, which no finite sequence of exact events resolves and the
+    /// time-stepped engine simulates. The state at the error's time is consistent
+    /// (every ball where its motion puts it, nothing overlapping), so the run can go on
+    /// from it with the stepped engine ([`HandOver`](crate::HandOver)).
+    SustainedContact,
+}
+
+impl SimError {
+    /// A failure of kind [`SimErrorKind::Failed`] at `time`.
+    pub fn new(time: f64, message: impl Into<String>) -> Self {
+        Self {
+            time,
+            message: message.into(),
+            kind: SimErrorKind::Failed,
+        }
+    }
+
+    /// A failure of kind [`SimErrorKind::SustainedContact`] at `time`.
+    pub fn sustained_contact(time: f64, message: impl Into<String>) -> Self {
+        Self {
+            time,
+            message: message.into(),
+            kind: SimErrorKind::SustainedContact,
+        }
+    }
 }
 
 /// The common face of carom's engines.
@@ -186,4 +238,20 @@ where
 
     /// The collisions so far.
     fn counters(&self) -> Counters;
+
+    /// When and why the run was handed over from the event engine to the stepped
+    /// engine, if it was (only the engine `--engine auto` builds does,
+    /// [`EventThenStepped`](crate::EventThenStepped)).
+    fn hand_over(&self) -> Option<&HandOver<T>> {
+        None
+    }
+}
+
+/// A run handed over from the event-driven engine to the time-stepped engine.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HandOver<T: Real> {
+    /// The (signed) simulation time of the hand-over.
+    pub time: T,
+    /// Why the event engine could not go on (its error message).
+    pub reason: String,
 }

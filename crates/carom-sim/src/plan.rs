@@ -6,7 +6,9 @@
 //! time-stepped engine otherwise (drag; balls that start stacked on each other under
 //! gravity, a sustained contact; stuck clusters in 3D, whose torque-free tumbling has no
 //! closed form the event engine could use, or under gravity, against boxes or in a
-//! periodic border), or when the user asks for an integrator or a step.
+//! periodic border), or when the user asks for an integrator or a step. A run `auto`
+//! starts on the event engine is handed over to the stepped engine if it meets sustained
+//! contact on the way ([`Plan::hand_over`]).
 //! The stepped engine runs every scene the format allows. The engine then builds only the parts the scene uses and
 //! names them in [`Simulation::pipeline`](crate::Simulation::pipeline).
 
@@ -113,6 +115,24 @@ pub struct Plan {
     pub dt: Option<f64>,
     /// The broad-phase request, resolved further by the engine.
     pub broad: BroadChoice,
+    /// The event engine was chosen by `--engine auto`: a run that meets sustained contact
+    /// is handed over to the stepped engine ([`EventThenStepped`](crate::EventThenStepped))
+    /// instead of ending with an error.
+    pub hand_over: bool,
+}
+
+impl Plan {
+    /// The event engine, as `--engine event --broad broad` plans it (no hand-over).
+    pub fn event(broad: BroadChoice) -> Self {
+        Self {
+            engine: EngineKind::Event,
+            reason: "requested with --engine event",
+            integrator: None,
+            dt: None,
+            broad,
+            hand_over: false,
+        }
+    }
 }
 
 /// Options that do not fit the scene or each other.
@@ -329,6 +349,7 @@ pub fn plan<T: Real, const D: usize>(
         integrator,
         dt,
         broad: options.broad,
+        hand_over: engine == EngineKind::Event && options.engine == EngineChoice::Auto,
     })
 }
 
@@ -341,10 +362,13 @@ mod tests {
     #[test]
     fn auto_picks_the_exact_engine_unless_the_scene_or_the_user_needs_steps() {
         let mut s = classic::head_on(1.0, 1.0, 1.0, -1.0, 1.0);
-        assert_eq!(
-            plan(&s, &RunOptions::default()).unwrap().engine,
-            EngineKind::Event
-        );
+        let auto = plan(&s, &RunOptions::default()).unwrap();
+        assert_eq!((auto.engine, auto.hand_over), (EngineKind::Event, true));
+        let forced = RunOptions {
+            engine: EngineChoice::Event,
+            ..RunOptions::default()
+        };
+        assert_eq!(plan(&s, &forced).unwrap(), Plan::event(BroadChoice::Auto));
         let rk4 = RunOptions {
             integrator: Some(Integrator::Rk4),
             ..RunOptions::default()

@@ -3,14 +3,17 @@
 //! [`sample_times`] turns `--until`, `--at` and `--every` into the ordered list of
 //! sample times; [`drive`] advances a [`Simulation`] through them, hands each sample
 //! and (optionally) each collision to a [`RunSink`], and returns the [`Summary`] of the
-//! contract: engine, pipeline, counts, energy and momentum before and after, wall time.
+//! contract: engine, pipeline, counts, energy and momentum before and after, wall time,
+//! and the hand-over from the event to the stepped engine if the run had one.
 
 use std::time::Instant;
 
 use carom_math::{Real, Space, Vector};
 use nalgebra::Const;
 
-use crate::engine::{BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation};
+use crate::engine::{
+    BallStates, Collision, Counters, EngineKind, HandOver, Observer, SimError, Simulation,
+};
 use crate::observe::{energy, momentum};
 use crate::plan::PlanError;
 use crate::scene::Scene;
@@ -87,8 +90,11 @@ where
 /// The summary line of the contract.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Summary<T: Real, const D: usize> {
-    /// The engine that ran.
+    /// The engine that ran (at the end of the run).
     pub engine: EngineKind,
+    /// When and why the run went over from the event engine to the stepped one, if it
+    /// did ([`Simulation::hand_over`]).
+    pub hand_over: Option<HandOver<T>>,
     /// The components it used.
     pub pipeline: Vec<String>,
     /// Collision counts.
@@ -162,6 +168,7 @@ where
     }
     Ok(Summary {
         engine: sim.kind(),
+        hand_over: sim.hand_over().cloned(),
         pipeline: sim.pipeline(),
         counters: sim.counters(),
         energy_initial,

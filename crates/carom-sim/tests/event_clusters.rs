@@ -3,7 +3,7 @@
 use carom_sim::plan::{BroadChoice, Plan};
 use carom_sim::scene::Inelastic;
 use carom_sim::scenes::collision_lab::{InelasticPreset, Options, Screen, scene};
-use carom_sim::{BallStates, Collision, EngineKind, EventEngine, Observer, Simulation};
+use carom_sim::{BallStates, Collision, EventEngine, Observer, Simulation};
 use carom_toi::Direction;
 use nalgebra::Vector2;
 
@@ -17,13 +17,7 @@ impl Observer<f64> for Log {
 }
 
 fn plan() -> Plan {
-    Plan {
-        engine: EngineKind::Event,
-        reason: "test",
-        integrator: None,
-        dt: None,
-        broad: BroadChoice::Auto,
-    }
+    Plan::event(BroadChoice::Auto)
 }
 
 fn stick(preset: InelasticPreset, border: bool) -> carom_sim::scene::Scene<f64, 2> {

@@ -10,7 +10,7 @@ use carom_math::{Space, Vector};
 use carom_sim::plan::{BroadChoice, Plan};
 use carom_sim::scene::{BallSpec, BorderSpec, Scene, World};
 use carom_sim::scenes::gas::{GasParams, gas};
-use carom_sim::{BallStates, Collision, EngineKind, EventEngine, Observer, PairSearch, Simulation};
+use carom_sim::{BallStates, Collision, EventEngine, Observer, PairSearch, Simulation};
 use carom_toi::Direction;
 use nalgebra::{Const, Vector2};
 
@@ -21,13 +21,7 @@ const SEARCHES: [PairSearch; 3] = [
 ];
 
 fn plan() -> Plan {
-    Plan {
-        engine: EngineKind::Event,
-        reason: "test",
-        integrator: None,
-        dt: None,
-        broad: BroadChoice::Auto,
-    }
+    Plan::event(BroadChoice::Auto)
 }
 
 #[derive(Default)]

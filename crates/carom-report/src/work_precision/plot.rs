@@ -240,12 +240,13 @@ mod tests {
                 seconds,
             })
             .collect();
-        let dir = std::env::temp_dir().join(format!("carom-wp-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let files = plot(&rows, &dir).unwrap();
+        let dir = tempfile::Builder::new()
+            .prefix("carom-wp-")
+            .tempdir()
+            .unwrap();
+        let files = plot(&rows, dir.path()).unwrap();
         assert_eq!(files.len(), 1);
         let svg = std::fs::read_to_string(&files[0]).unwrap();
         assert!(svg.contains("<svg") && svg.contains("carom-stepped/rk4"));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -555,9 +555,11 @@ where
             (None, Some((_, b))) => *b,
             (None, None) => return Ok(()),
         };
-        let fusion = self.clusters[c].rigid.fuse(&other).map_err(|e| SimError {
-            time: (now * self.sign).to_f64(),
-            message: format!("fusing a stuck cluster: {e}"),
+        let fusion = self.clusters[c].rigid.fuse(&other).map_err(|e| {
+            SimError::new(
+                (now * self.sign).to_f64(),
+                format!("fusing a stuck cluster: {e}"),
+            )
         })?;
         let mut members = std::mem::take(&mut self.clusters[c].members);
         let mut offsets: Vec<Vector<T, D>> = self.clusters[c]
@@ -588,12 +590,14 @@ where
             .zip(&offsets)
             .map(|(&m, o)| (*o, self.balls.motion[m as usize].radius))
             .collect();
-        let shape = Cluster::new(&shape_balls).map_err(|e| SimError {
-            time: (now * self.sign).to_f64(),
-            message: format!(
-                "a stuck cluster can hold at most {} balls (carom-toi's limit): {e}",
-                Cluster::<T, D>::MAX_BALLS
-            ),
+        let shape = Cluster::new(&shape_balls).map_err(|e| {
+            SimError::new(
+                (now * self.sign).to_f64(),
+                format!(
+                    "a stuck cluster can hold at most {} balls (carom-toi's limit): {e}",
+                    Cluster::<T, D>::MAX_BALLS
+                ),
+            )
         })?;
         for &m in &members {
             self.balls.mode[m as usize] = Mode::Stuck(c);

@@ -614,13 +614,13 @@ where
     fn advance_to(&mut self, target: T, observer: &mut dyn Observer<T>) -> Result<(), SimError> {
         let target = target * self.sign;
         if target < self.now {
-            return Err(SimError {
-                time: (self.now * self.sign).to_f64(),
-                message: format!(
+            return Err(SimError::new(
+                (self.now * self.sign).to_f64(),
+                format!(
                     "cannot advance to {} which is behind the current time",
                     (target * self.sign).to_f64()
                 ),
-            });
+            ));
         }
         let mut processed: u64 = 0;
         while let Some((i, t)) = self.calendar.peek() {
@@ -637,18 +637,22 @@ where
             }
             self.events_at_instant += 1;
             if self.events_at_instant > self.events_allowed_at_one_instant {
-                return Err(SimError {
-                    time: (self.now * self.sign).to_f64(),
-                    message: format!(
-                        "more than {} events at one instant: a cascade of simultaneous collisions that does not end ({}){}",
-                        self.events_allowed_at_one_instant,
-                        self.slot_name(i),
-                        if self.balls.accelerated {
-                            "; under gravity this is usually balls pressed together (a stack, a pile, a wedge), sustained contact that only the stepped engine simulates"
-                        } else {
-                            ""
-                        }
-                    ),
+                let time = (self.now * self.sign).to_f64();
+                let message = format!(
+                    "more than {} events at one instant: a cascade of simultaneous collisions that does not end ({})",
+                    self.events_allowed_at_one_instant,
+                    self.slot_name(i),
+                );
+                // Without gravity nothing presses bodies together but a kinematic box,
+                // and a box driving balls into the border crushes them in any engine.
+                return Err(if self.balls.accelerated {
+                    SimError::sustained_contact(
+                        time,
+                        message
+                            + "; under gravity this is usually balls pressed together (a stack, a pile, a wedge), sustained contact that only the stepped engine simulates (--engine auto hands the run over to it)",
+                    )
+                } else {
+                    SimError::new(time, message)
                 });
             }
             self.handle(i, observer)?;

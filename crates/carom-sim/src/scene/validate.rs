@@ -88,7 +88,11 @@ impl<T: Real, const D: usize> Scene<T, D> {
         self.validate_placement()
     }
 
-    fn validate_fields(&self) -> Result<(), SceneError> {
+    /// The field rules alone (not the placement).
+    ///
+    /// # Errors
+    /// As [`Scene::validate`].
+    pub(crate) fn validate_fields(&self) -> Result<(), SceneError> {
         let w = &self.world;
         let world = at("world");
         ensure_finite_vector("gravity", &w.gravity).map_err(&world)?;

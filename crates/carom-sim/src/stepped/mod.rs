@@ -230,6 +230,37 @@ where
     /// balls (two ball diameters must fit in half a period).
     pub fn new(scene: &Scene<T, D>, plan: &Plan, direction: Direction) -> Result<Self, SceneError> {
         scene.validate()?;
+        Self::with_valid_fields(scene, plan, direction)
+    }
+
+    /// The engine taking a run on from another engine's state: `scene` holds the balls
+    /// where that engine left them, and `spins` their angular velocities as
+    /// [`Simulation::states`] reports them (a scene has none; friction gives balls
+    /// spin). The fields are checked, not the placement: balls the event engine hands
+    /// over pressed together may overlap by a little more than a scene may start with
+    /// (it hands over at [`OVERLAP_TOLERANCE`](crate::scene::OVERLAP_TOLERANCE) plus
+    /// rounding, see [`EventThenStepped`](crate::EventThenStepped)), and the stepped
+    /// engine resolves such contacts as it does its own.
+    pub(crate) fn continuing(
+        scene: &Scene<T, D>,
+        plan: &Plan,
+        direction: Direction,
+        spins: &[crate::Angular<T, D>],
+    ) -> Result<Self, SceneError> {
+        scene.validate_fields()?;
+        let mut engine = Self::with_valid_fields(scene, plan, direction)?;
+        for (w, spin) in engine.balls.spin.iter_mut().zip(spins) {
+            *w = *spin * engine.clock.sign;
+        }
+        Ok(engine)
+    }
+
+    /// [`SteppedEngine::new`] for a scene whose fields are valid.
+    fn with_valid_fields(
+        scene: &Scene<T, D>,
+        plan: &Plan,
+        direction: Direction,
+    ) -> Result<Self, SceneError> {
         let n = scene.balls.len();
         if u32::try_from(n + scene.boxes.len()).is_err() {
             return Err(SceneError::new("balls", "more than 2^32 balls and boxes"));
@@ -655,12 +686,12 @@ where
                 Target::Border => "the border".to_string(),
                 Target::Box(k) => format!("boxes[{k}]"),
             };
-            return Err(SimError {
-                time: ((t0 + e.time) * self.clock.sign + T::zero()).to_f64(),
-                message: format!(
+            return Err(SimError::new(
+                ((t0 + e.time) * self.clock.sign + T::zero()).to_f64(),
+                format!(
                     "balls[{i}] is crushed: more than {CRUSH_CONTACTS} contacts at one instant (the last with {by}), even held against all of them at once: it cannot give way (as when a kinematic box presses it into the border or another box from every side it could leave by)"
                 ),
-            });
+            ));
         }
         Ok(repeat == Repeat::Wedged)
     }
@@ -704,10 +735,7 @@ where
             t0,
         };
         let time = (t0 + e.time) * self.clock.sign + T::zero();
-        let stuck_error = |message: String| SimError {
-            time: time.to_f64(),
-            message,
-        };
+        let stuck_error = |message: String| SimError::new(time.to_f64(), message);
         let (effect, collision): (Effect, Collision<T>) = match e.target {
             Target::Ball(j) => {
                 let j = j as usize;
@@ -941,13 +969,13 @@ where
     }
 
     fn overflow(&self, o: Overflow, s: T) -> SimError {
-        SimError {
-            time: (s * self.clock.sign).to_f64(),
-            message: format!(
+        SimError::new(
+            (s * self.clock.sign).to_f64(),
+            format!(
                 "a time of impact of ball {} overflowed this precision (coordinates or speeds too large)",
                 o.ball
             ),
-        }
+        )
     }
 
     /// The end of the window starting at `a` in a step of length `h`: the step's end, or
@@ -1064,9 +1092,9 @@ where
             .collect();
         let more = if members.len() > 4 { ", ..." } else { "" };
         let limit = MAX_TURN * MAX_SUBSTEPS as f64;
-        SimError {
-            time: self.time().to_f64(),
-            message: format!(
+        SimError::new(
+            self.time().to_f64(),
+            format!(
                 "a stuck cluster of {} balls ({}{more}) spins at {:e} rad/s: it would turn {:e} rad in the step, more than the {limit} rad the stepped engine follows in one step ({MAX_SUBSTEPS} sub-steps of at most {MAX_TURN} rad); use a --dt below {:e} s (below {:e} s it needs no sub-steps)",
                 members.len(),
                 named.join(", "),
@@ -1075,7 +1103,7 @@ where
                 limit / spin.to_f64(),
                 MAX_TURN / spin.to_f64()
             ),
-        }
+        )
     }
 
     /// One step of length `h` from the current time; returns the length it took: `h`, or
@@ -1187,9 +1215,9 @@ where
         let h = T::lit(self.clock.dt);
         let tolerance = (T::lit(1e-9) * h).max(T::lit(64.0) * T::EPSILON * goal.abs());
         if !goal.finite() || goal < self.clock.s - tolerance {
-            return Err(SimError {
-                time: self.time().to_f64(),
-                message: format!(
+            return Err(SimError::new(
+                self.time().to_f64(),
+                format!(
                     "cannot advance to {target}: the run is at {} and goes {}",
                     self.time(),
                     if sign > T::zero() {
@@ -1198,7 +1226,7 @@ where
                         "backward"
                     }
                 ),
-            });
+            ));
         }
         while goal - self.clock.s > tolerance {
             let next = self.clock.grid(self.clock.k + 1);
