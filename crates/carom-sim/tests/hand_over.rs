@@ -295,3 +295,59 @@ fn the_stepped_engine_starts_from_the_event_engines_state_spins_included() {
     sim.states(&mut handed);
     assert_eq!(handed, at_error);
 }
+
+/// A ball set down on a box's corner, its centre beyond the corner, slides around it and
+/// leaves it (frictionless, a point pivot) where `cos θ = (2/3) cos θ₀`, at
+/// `v² = 2 g r (cos θ₀ − cos θ)` along the tangent. The event engine cannot hold a ball
+/// on a corner: it hopped there at the resolution of the position (6.6 million hops for
+/// this pivot before it was refused: exact, 8.6 s for 1 s). It now ends with sustained
+/// contact after 64 such hops, and `auto` hands the pivot over to the stepped engine.
+#[test]
+fn a_ball_pivoting_over_a_box_corner_is_handed_over_and_leaves_at_the_closed_form_speed() {
+    let mut scene = pile::<2>();
+    scene.balls = vec![BallSpec::new(
+        Vector::<f64, 2>::new(0.6 * R, 0.8 * R + 0.5),
+        Vector::zeros(),
+        R,
+        1.0,
+    )];
+    scene.boxes.push(BoxSpec {
+        shape: Obb::from_aabb(
+            &Aabb::new(
+                Vector::<f64, 2>::new(-0.9, 0.25),
+                Vector::<f64, 2>::new(0.0, 0.5),
+            )
+            .unwrap(),
+        ),
+        vel: Vector::zeros(),
+        restitution: 0.0,
+    });
+    let mut exact = build(&scene, &Plan::event(BroadChoice::Auto), Direction::Forward).unwrap();
+    let err = exact.advance_to(0.3, &mut ()).unwrap_err();
+    assert_eq!(err.kind, SimErrorKind::SustainedContact, "{err}");
+    assert!(err.message.contains("edge or a corner"), "{err}");
+    assert!(err.time < 1e-3, "{err}");
+
+    let (summary, keep) = run_auto(&scene, 0.3, 0.01);
+    assert_eq!(summary.hand_over.map(|h| h.time), Some(err.time));
+    let (cos0, cos1) = (0.8, 0.8 * 2.0 / 3.0);
+    let speed = (2.0 * G * R * (cos0 - cos1)).sqrt();
+    let leaving = speed * cos1;
+    let (_, last) = keep.samples.last().unwrap();
+    // The stepped engine's default step (1/600 s) follows the slide to 0.2 %.
+    assert!(
+        (last.vel[0].x - leaving).abs() < 5e-3 * leaving,
+        "leaves at {} instead of {leaving}",
+        last.vel[0].x
+    );
+    // Never in the box [−0.9, 0] × [0.25, 0.5].
+    for (t, s) in &keep.samples {
+        let (x, y) = (s.pos[0].x, s.pos[0].y);
+        let dx = (-0.9 - x).max(x).max(0.0);
+        let dy = (0.25 - y).max(y - 0.5).max(0.0);
+        assert!(
+            dx.hypot(dy) >= R - 1e-8,
+            "t = {t}: the ball at ({x}, {y}) enters the box"
+        );
+    }
+}

@@ -245,6 +245,9 @@ where
     /// (a second such collision of the pair at a later time ends the run: sustained
     /// contact).
     resting_pair: Option<((usize, usize), T)>,
+    /// The last ball held where this engine cannot rest it (between two surfaces, on an
+    /// edge), when, and how many times in a row (`refuse_held`).
+    held: Option<(usize, T, u32)>,
     /// The most events at one instant before a cascade is declared endless.
     events_allowed_at_one_instant: usize,
     pipeline: Vec<String>,
@@ -363,6 +366,7 @@ where
             events_at_instant: 0,
             instant_width: instant_width(scene, length_scale(scene)),
             resting_pair: None,
+            held: None,
             events_allowed_at_one_instant: events_allowed_at_one_instant(
                 scene.balls.iter().map(|b| b.mass),
             ),
