@@ -23,7 +23,7 @@ use crate::engine::{
     Simulation,
 };
 use crate::event::EventEngine;
-use crate::plan::{EngineChoice, Plan, RunOptions, plan};
+use crate::plan::{BroadChoice, EngineChoice, Plan, RunOptions, plan};
 use crate::scene::{Scene, SceneError};
 use crate::stepped::SteppedEngine;
 
@@ -36,20 +36,30 @@ where
     /// The scene as given, at time 0.
     scene: Scene<T, D>,
     /// The broad-phase request, which the stepped engine honours too.
-    plan: Plan,
+    broad: BroadChoice,
     direction: Direction,
-    event: EventEngine<T, D>,
-    /// The stepped engine once the run is handed over, and when that was.
-    stepped: Option<Shifted<T, D>>,
+    stage: Stage<T, D>,
 }
 
-/// The stepped engine started at (signed) time `start`: its own clock starts at 0.
+/// Which engine runs now. The event engine is dropped at the hand-over.
+enum Stage<T: Real, const D: usize>
+where
+    Const<D>: Space<T, D>,
+{
+    Event(Box<EventEngine<T, D>>),
+    Stepped(Box<Shifted<T, D>>),
+}
+
+/// The stepped engine started at (signed) time `record.time`, its own clock at 0 then,
+/// with what the run kept of the event engine.
 struct Shifted<T: Real, const D: usize>
 where
     Const<D>: Space<T, D>,
 {
     engine: SteppedEngine<T, D>,
     record: HandOver<T>,
+    /// The event engine's components.
+    event_pipeline: Vec<String>,
     /// The event engine's collisions before the hand-over.
     before: Counters,
 }
@@ -66,17 +76,20 @@ where
     pub fn new(scene: &Scene<T, D>, plan: &Plan, direction: Direction) -> Result<Self, SceneError> {
         Ok(Self {
             scene: scene.clone(),
-            plan: *plan,
+            broad: plan.broad,
             direction,
-            event: EventEngine::new(scene, plan, direction)?,
-            stepped: None,
+            stage: Stage::Event(Box::new(EventEngine::new(scene, plan, direction)?)),
         })
     }
 
-    /// Builds the stepped engine from the event engine's state at the instant of
-    /// `error`, or gives the error back if it cannot take the run on.
-    fn switch_to_stepped(&mut self, error: SimError) -> Result<(), SimError> {
-        let start = self.event.time();
+    /// Builds the stepped engine from `event`'s state at the instant of `error`, or gives
+    /// the error back if it cannot take the run on.
+    fn switch_to_stepped(
+        &self,
+        event: &EventEngine<T, D>,
+        error: SimError,
+    ) -> Result<Shifted<T, D>, SimError> {
+        let start = event.time();
         let failed = |what: String| {
             SimError::new(
                 start.to_f64(),
@@ -87,25 +100,25 @@ where
             )
         };
         let mut states = BallStates::default();
-        self.event.states(&mut states);
+        event.states(&mut states);
         let scene = scene_at(&self.scene, start, &states);
         let options = RunOptions {
             engine: EngineChoice::Stepped,
-            broad: self.plan.broad,
+            broad: self.broad,
             ..RunOptions::default()
         };
         let stepped_plan = plan(&scene, &options).map_err(|e| failed(e.0))?;
         let engine = SteppedEngine::continuing(&scene, &stepped_plan, self.direction, &states.spin)
             .map_err(|e| failed(e.to_string()))?;
-        self.stepped = Some(Shifted {
+        Ok(Shifted {
             engine,
             record: HandOver {
                 time: start,
                 reason: error.message,
             },
-            before: self.event.counters(),
-        });
-        Ok(())
+            event_pipeline: event.pipeline(),
+            before: event.counters(),
+        })
     }
 }
 
@@ -150,36 +163,46 @@ where
     Const<D>: Space<T, D>,
 {
     fn kind(&self) -> EngineKind {
-        match self.stepped {
-            None => EngineKind::Event,
-            Some(_) => EngineKind::Stepped,
+        match self.stage {
+            Stage::Event(_) => EngineKind::Event,
+            Stage::Stepped(_) => EngineKind::Stepped,
         }
     }
 
     /// The event engine's components, then (after a hand-over) the stepped engine's.
     fn pipeline(&self) -> Vec<String> {
-        let mut p = self.event.pipeline();
-        if let Some(s) = &self.stepped {
-            p.extend(s.engine.pipeline());
+        match &self.stage {
+            Stage::Event(event) => event.pipeline(),
+            Stage::Stepped(s) => {
+                let mut p = s.event_pipeline.clone();
+                p.extend(s.engine.pipeline());
+                p
+            }
         }
-        p
     }
 
     fn time(&self) -> T {
-        match &self.stepped {
-            None => self.event.time(),
-            Some(s) => s.record.time + s.engine.time(),
+        match &self.stage {
+            Stage::Event(event) => event.time(),
+            Stage::Stepped(s) => s.record.time + s.engine.time(),
         }
     }
 
     fn advance_to(&mut self, target: T, observer: &mut dyn Observer<T>) -> Result<(), SimError> {
-        if self.stepped.is_none() {
-            match self.event.advance_to(target, observer) {
-                Err(e) if e.kind == SimErrorKind::SustainedContact => self.switch_to_stepped(e)?,
+        if let Stage::Event(event) = &mut self.stage {
+            match event.advance_to(target, observer) {
+                Err(e) if e.kind == SimErrorKind::SustainedContact => {
+                    let Stage::Event(event) = &self.stage else {
+                        unreachable!("the event stage")
+                    };
+                    self.stage = Stage::Stepped(Box::new(self.switch_to_stepped(event, e)?));
+                }
                 done => return done,
             }
         }
-        let s = self.stepped.as_mut().expect("handed over above");
+        let Stage::Stepped(s) = &mut self.stage else {
+            unreachable!("handed over above")
+        };
         let start = s.record.time;
         let mut shifted = ShiftedObserver {
             inner: observer,
@@ -194,16 +217,16 @@ where
     }
 
     fn states(&self, out: &mut BallStates<T, D>) {
-        match &self.stepped {
-            None => self.event.states(out),
-            Some(s) => s.engine.states(out),
+        match &self.stage {
+            Stage::Event(event) => event.states(out),
+            Stage::Stepped(s) => s.engine.states(out),
         }
     }
 
     fn counters(&self) -> Counters {
-        match &self.stepped {
-            None => self.event.counters(),
-            Some(s) => {
+        match &self.stage {
+            Stage::Event(event) => event.counters(),
+            Stage::Stepped(s) => {
                 let after = s.engine.counters();
                 Counters {
                     ball_ball: s.before.ball_ball + after.ball_ball,
@@ -215,6 +238,9 @@ where
     }
 
     fn hand_over(&self) -> Option<&HandOver<T>> {
-        self.stepped.as_ref().map(|s| &s.record)
+        match &self.stage {
+            Stage::Event(_) => None,
+            Stage::Stepped(s) => Some(&s.record),
+        }
     }
 }
