@@ -284,8 +284,7 @@ where
         );
         let overlap = self.balls.motion[i].radius + self.balls.motion[j].radius
             - self.separation(&a, &b).norm();
-        let allowed =
-            T::lit(OVERLAP_TOLERANCE) + T::lit(4.0) * coordinate_resolution(a.amax().max(b.amax()));
+        let allowed = T::lit(OVERLAP_TOLERANCE) + coordinate_resolution(a.amax().max(b.amax()));
         if overlap <= allowed {
             return Ok(());
         }
