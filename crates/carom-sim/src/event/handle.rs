@@ -7,7 +7,12 @@
 //! guards first: the TC model for ball–ball collisions, the resting guard for bounces on
 //! a surface that gravity presses the ball onto. Every resolved contact leaves at least
 //! at the rounding speed of its velocities, so that rounding cannot bring the same
-//! contact due again at once ([`parting_shortfall`]).
+//! contact due again at once ([`parting_shortfall`]). Sustained contact, which no
+//! finite sequence of exact events resolves, ends the run with a
+//! [`SustainedContact`](crate::SimErrorKind::SustainedContact) error, which
+//! `--engine auto` hands over to the stepped engine: balls resting on each other or
+//! sinking into each other under gravity, a ball held between two surfaces or on an
+//! edge.
 
 use carom_geometry::query::PointQuery;
 use carom_math::{Real, Space, Vector};
@@ -418,7 +423,7 @@ where
             self.refuse_held(i, || {
                 format!(
                     "ball {i} is held on {}, which cannot hold it at rest (an edge or a corner it pivots over)",
-                    support.map_or_else(|| "an edge or a corner of a box".to_owned(), describe)
+                    describe(support)
                 )
             })?;
         }
@@ -590,8 +595,8 @@ where
         self.refuse_held(i, || {
             format!(
                 "ball {i} rests on {} and is held against {} (a corner or a wedge)",
-                describe(resting_on),
-                support.map_or_else(|| "an edge or a corner of a box".to_owned(), describe),
+                describe(Some(resting_on)),
+                describe(support),
             )
         })
     }
@@ -632,14 +637,16 @@ where
 /// event engine cannot rest it before the run ends ([`EventEngine::refuse_held`]).
 const HELD_REPEATS: u32 = 64;
 
-/// A surface that can hold a ball, named for a message.
-fn describe(support: Support) -> String {
+/// A surface a ball meets, named for a message: a face that can hold it, or (`None`) an
+/// edge or a corner of a box.
+fn describe(support: Option<Support>) -> String {
     match support {
-        Support::Wall { axis, upper } => format!(
+        Some(Support::Wall { axis, upper }) => format!(
             "the border's {} wall on axis {axis}",
             if upper { "upper" } else { "lower" }
         ),
-        Support::BoxFace { k, .. } => format!("a face of boxes[{k}]"),
+        Some(Support::BoxFace { k, .. }) => format!("a face of boxes[{k}]"),
+        None => "an edge or a corner of a box".to_owned(),
     }
 }
 
