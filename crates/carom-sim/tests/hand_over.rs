@@ -2,13 +2,16 @@
 //! balls come to rest on each other (sustained contact): the exact run up to that
 //! instant, the stepped engine's from there, one clock, one summary.
 
+mod common;
+
 use carom_geometry::{Aabb, Border, Obb};
 use carom_math::Vector;
 use carom_sim::plan::{BroadChoice, Plan, RunOptions, plan};
-use carom_sim::run::{RunSink, Summary, drive, sample_times};
+use carom_sim::run::{Summary, drive, sample_times};
 use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
 use carom_sim::{BallStates, Collision, EngineKind, SimErrorKind, build};
 use carom_toi::Direction;
+use common::Keep;
 use nalgebra::Const;
 
 const G: f64 = 9.81;
@@ -38,39 +41,6 @@ fn pile<const D: usize>() -> Scene<f64, D> {
             BallSpec::new(up(1.2), Vector::zeros(), R, 1.0),
         ],
         boxes: Vec::new(),
-    }
-}
-
-/// What `drive` hands its sink.
-struct Keep<const D: usize>
-where
-    Const<D>: carom_math::Space<f64, D>,
-{
-    samples: Vec<(f64, BallStates<f64, D>)>,
-    collisions: Vec<Collision<f64>>,
-}
-
-impl<const D: usize> Default for Keep<D>
-where
-    Const<D>: carom_math::Space<f64, D>,
-{
-    fn default() -> Self {
-        Self {
-            samples: Vec::new(),
-            collisions: Vec::new(),
-        }
-    }
-}
-
-impl<const D: usize> RunSink<f64, D> for Keep<D>
-where
-    Const<D>: carom_math::Space<f64, D>,
-{
-    fn sample(&mut self, t: f64, states: &BallStates<f64, D>) {
-        self.samples.push((t, states.clone()));
-    }
-    fn collision(&mut self, collision: &Collision<f64>) {
-        self.collisions.push(*collision);
     }
 }
 

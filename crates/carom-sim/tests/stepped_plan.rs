@@ -6,12 +6,12 @@ mod common;
 use carom_geometry::Border;
 use carom_integrate::Integrator;
 use carom_sim::plan::{BroadChoice, EngineChoice, Plan, RunOptions, plan, stepped_broad_phase};
-use carom_sim::run::{RunSink, drive, sample_times};
+use carom_sim::run::{drive, sample_times};
 use carom_sim::scene::{BallSpec, BorderSpec, Inelastic, Scene, World};
 use carom_sim::scenes::classic;
 use carom_sim::scenes::gas::{GasParams, gas};
 use carom_sim::stepped::SteppedEngine;
-use carom_sim::{BallStates, Collision, EngineKind, Simulation, build};
+use carom_sim::{BallStates, EngineKind, Simulation, build};
 use carom_toi::Direction;
 use nalgebra::{Vector2, Vector3};
 
@@ -270,22 +270,6 @@ fn stick_scenes_run_on_the_stepped_engine_and_auto_picks_it_where_the_event_engi
     assert!(has_stick(&p, &s));
 }
 
-/// A sink that keeps what `drive` hands it.
-#[derive(Default)]
-struct Keep {
-    samples: Vec<(f64, BallStates<f64, 3>)>,
-    collisions: Vec<Collision<f64>>,
-}
-
-impl RunSink<f64, 3> for Keep {
-    fn sample(&mut self, t: f64, states: &BallStates<f64, 3>) {
-        self.samples.push((t, states.clone()));
-    }
-    fn collision(&mut self, collision: &Collision<f64>) {
-        self.collisions.push(*collision);
-    }
-}
-
 #[test]
 fn carom_run_drives_the_stepped_engine_through_its_samples() {
     // What `carom run scene.toml --engine stepped --until 2 --every 0.5 --events` does.
@@ -301,7 +285,7 @@ fn carom_run_drives_the_stepped_engine_through_its_samples() {
     .unwrap();
     let mut sim = build(&s, &p, Direction::Forward).unwrap();
     let times = sample_times(2.0, &[], Some(0.5)).unwrap();
-    let mut sink = Keep::default();
+    let mut sink = common::Keep::<3>::default();
     let summary = drive(sim.as_mut(), &s, &times, &mut sink, true).unwrap();
     assert_eq!(
         sink.samples.iter().map(|(t, _)| *t).collect::<Vec<_>>(),

@@ -342,6 +342,7 @@ where
                 restitution: b.restitution,
             })
             .collect();
+        let scale = length_scale(scene);
         let mut engine = Self {
             sign,
             gravity: scene.world.gravity,
@@ -355,7 +356,7 @@ where
             friction: scene.world.friction,
             collapse,
             resting,
-            length_scale: length_scale(scene),
+            length_scale: scale,
             balls,
             clusters: Vec::new(),
             partners,
@@ -364,7 +365,7 @@ where
             now: T::zero(),
             counters: Counters::default(),
             events_at_instant: 0,
-            instant_width: instant_width(scene, length_scale(scene)),
+            instant_width: instant_width(scene, scale),
             resting_pair: None,
             held: None,
             events_allowed_at_one_instant: events_allowed_at_one_instant(

@@ -238,9 +238,9 @@ where
     /// [`Simulation::states`] reports them (a scene has none; friction gives balls
     /// spin). The fields are checked, not the placement: balls the event engine hands
     /// over pressed together may overlap by a little more than a scene may start with
-    /// (it hands over at [`OVERLAP_TOLERANCE`](crate::scene::OVERLAP_TOLERANCE) plus
-    /// rounding, see [`EventThenStepped`](crate::EventThenStepped)), and the stepped
-    /// engine resolves such contacts as it does its own.
+    /// (up to [`OVERLAP_TOLERANCE`](crate::scene::OVERLAP_TOLERANCE) plus the resolution
+    /// of their coordinates, see [`EventThenStepped`](crate::EventThenStepped)), and the
+    /// stepped engine resolves such contacts as it does its own.
     pub(crate) fn continuing(
         scene: &Scene<T, D>,
         plan: &Plan,

@@ -1,12 +1,13 @@
-//! Helpers shared by the stepped-engine tests: building an engine from a scene with
-//! given options, collecting collisions, reading states, checking that a resting scene
-//! stays put.
+//! Helpers shared by the stepped-engine and hand-over tests: building an engine from a
+//! scene with given options, collecting collisions, keeping what `carom run`'s driver
+//! hands its sink, reading states, checking that a resting scene stays put.
 
 #![allow(dead_code)] // each test file uses a part
 
 use carom_integrate::Integrator;
 use carom_math::{Real, Space, Vector};
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};
+use carom_sim::run::RunSink;
 use carom_sim::scene::Scene;
 use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Collision, Observer, Simulation, observe};
@@ -69,6 +70,40 @@ impl<T: Real> Observer<T> for Recorder<T> {
     }
     fn progress(&mut self, t: T) {
         self.progress.push(t);
+    }
+}
+
+/// A sink that keeps what [`carom_sim::run::drive`] hands it: every sample and, when
+/// asked for, every collision.
+pub(crate) struct Keep<const D: usize>
+where
+    Const<D>: Space<f64, D>,
+{
+    pub(crate) samples: Vec<(f64, BallStates<f64, D>)>,
+    pub(crate) collisions: Vec<Collision<f64>>,
+}
+
+impl<const D: usize> Default for Keep<D>
+where
+    Const<D>: Space<f64, D>,
+{
+    fn default() -> Self {
+        Self {
+            samples: Vec::new(),
+            collisions: Vec::new(),
+        }
+    }
+}
+
+impl<const D: usize> RunSink<f64, D> for Keep<D>
+where
+    Const<D>: Space<f64, D>,
+{
+    fn sample(&mut self, t: f64, states: &BallStates<f64, D>) {
+        self.samples.push((t, states.clone()));
+    }
+    fn collision(&mut self, collision: &Collision<f64>) {
+        self.collisions.push(*collision);
     }
 }
 
