@@ -18,6 +18,7 @@ mod engine;
 pub mod event;
 mod handover;
 pub mod observe;
+mod pages;
 pub mod plan;
 mod prefetch;
 pub mod run;

@@ -15,6 +15,18 @@
 //! events, scheduling and popping cost O(1) on average plus a heap of a handful of
 //! entries, instead of O(log N) in one big heap.
 //!
+//! The heap holds `(time, ball)` entries, so its comparisons read no per-ball array, and
+//! an event cancelled while in the heap is only forgotten (its ball's slot and time
+//! change); its entry is dropped, dead, when it reaches the top. An entry is live when
+//! its ball is in the heap at the entry's time: a ball cancelled and scheduled again at
+//! the same time leaves two equal entries, either of which stands for it (they order
+//! alike), and the other is dead once the ball leaves the heap. Every entry in the heap
+//! lies in a bucket at or before the current one, so the heap is empty, dead entries
+//! and all, before the cursor moves on; and when dead entries outnumber the live ones
+//! the heap is rebuilt from the live ones, so a long stay in one bucket (a cascade of
+//! events at one instant) cannot pile them up. Against a heap of ball indices that
+//! moved each ball's heap position with it: see `docs/event-engine.md`.
+//!
 //! Ties are broken by ball index, so the order of events is deterministic.
 
 use carom_math::{Real, floor_to_i64};
@@ -26,12 +38,35 @@ const NONE: u32 = u32::MAX;
 enum Slot {
     /// No event scheduled.
     Idle,
-    /// In the heap at this position.
-    Heap(u32),
+    /// In the heap (an entry at the ball's time is there).
+    Heap,
     /// In the list of this bucket (index into `heads`).
     Bucket(u32),
     /// In the overflow list at this position.
     Overflow(u32),
+}
+
+/// A heap entry: a ball and its event time when it entered the heap.
+#[derive(Clone, Copy, Debug)]
+struct Entry<T: Real> {
+    time: T,
+    ball: u32,
+}
+
+impl<T: Real> Entry<T> {
+    /// `true` if `self` comes before `other`: earlier time, then lower ball.
+    #[inline]
+    fn before(&self, other: &Self) -> bool {
+        self.time < other.time || (self.time == other.time && self.ball < other.ball)
+    }
+
+    /// `true` if the heap entry stands for its ball's event: the ball is in the heap at
+    /// the entry's time (`time` and `slot` are the calendar's per-ball arrays).
+    #[inline]
+    fn is_live(&self, time: &[T], slot: &[Slot]) -> bool {
+        let ball = self.ball as usize;
+        slot[ball] == Slot::Heap && time[ball] == self.time
+    }
 }
 
 /// A calendar of at most one event per ball.
@@ -42,7 +77,11 @@ pub struct Calendar<T: Real> {
     next: Vec<u32>,
     prev: Vec<u32>,
     heads: Vec<u32>,
-    heap: Vec<u32>,
+    /// The current bucket's events, a binary min-heap ordered by (time, ball), dead
+    /// entries included (see the module documentation).
+    heap: Vec<Entry<T>>,
+    /// The number of live entries in the heap.
+    heap_live: usize,
     overflow: Vec<u32>,
     /// The inverse of the bucket width.
     inv_width: T,
@@ -71,6 +110,7 @@ impl<T: Real> Calendar<T> {
             prev: vec![NONE; balls],
             heads: vec![NONE; buckets],
             heap: Vec::with_capacity(64),
+            heap_live: 0,
             overflow: Vec::new(),
             inv_width: T::one() / width,
             current: 0,
@@ -132,7 +172,8 @@ impl<T: Real> Calendar<T> {
     pub fn cancel(&mut self, ball: usize) {
         match self.slot[ball] {
             Slot::Idle => return,
-            Slot::Heap(pos) => self.heap_remove(pos as usize),
+            // Its entry stays in the heap, dead, until it reaches the top.
+            Slot::Heap => self.heap_live -= 1,
             Slot::Bucket(b) => self.list_remove(ball as u32, b as usize),
             Slot::Overflow(pos) => {
                 let pos = pos as usize;
@@ -149,24 +190,43 @@ impl<T: Real> Calendar<T> {
 
     /// The earliest event `(ball, time)` without removing it.
     pub fn peek(&mut self) -> Option<(usize, T)> {
-        self.refill();
-        self.heap
-            .first()
-            .map(|&b| (b as usize, self.time[b as usize]))
+        loop {
+            while let Some(&top) = self.heap.first() {
+                if self.is_live(&top) {
+                    return Some((top.ball as usize, top.time));
+                }
+                self.heap_pop();
+            }
+            if self.len == 0 {
+                return None;
+            }
+            self.refill();
+        }
     }
 
     /// Up to `k` of the next events' balls, the earliest first, the others in no
     /// particular order: the top of the heap of the current bucket (with `k = 3` it holds
-    /// the next two events, when the bucket has them). For prefetching their data.
-    pub fn upcoming(&self, k: usize) -> &[u32] {
-        &self.heap[..self.heap.len().min(k)]
+    /// the next two entries, when the bucket has them; an entry may be dead). For
+    /// prefetching their data.
+    pub fn upcoming(&self, k: usize) -> impl Iterator<Item = usize> + '_ {
+        self.heap[..self.heap.len().min(k)]
+            .iter()
+            .map(|e| e.ball as usize)
     }
 
     /// Removes and returns the earliest event `(ball, time)`; ties go to the lower ball.
     pub fn pop(&mut self) -> Option<(usize, T)> {
         let (ball, t) = self.peek()?;
+        self.heap_pop();
         self.cancel(ball);
         Some((ball, t))
+    }
+
+    /// `true` if the heap entry `entry` stands for its ball's event: the ball is in the
+    /// heap at the entry's time.
+    #[inline]
+    fn is_live(&self, entry: &Entry<T>) -> bool {
+        entry.is_live(&self.time, &self.slot)
     }
 
     /// Puts a ball whose time is set into the heap, a bucket or the overflow list.
@@ -182,14 +242,13 @@ impl<T: Real> Calendar<T> {
         }
     }
 
-    /// Moves the cursor forward until the heap holds the earliest events.
+    /// Moves the cursor forward until the heap holds the earliest events (called with
+    /// the heap empty and events scheduled).
     ///
     /// Invariant: heap events are in buckets `<= current`, list events in
     /// `(current, cycle_end)`, overflow events in `>= cycle_end`.
     fn refill(&mut self) {
-        if !self.heap.is_empty() || self.len == 0 {
-            return;
-        }
+        debug_assert!(self.heap.is_empty() && self.len > 0);
         let nb = self.heads.len() as i64;
         loop {
             let mut k = self.current + 1;
@@ -272,68 +331,71 @@ impl<T: Real> Calendar<T> {
         self.prev[ball as usize] = NONE;
     }
 
-    /// `true` if `a` comes before `b`: earlier time, then lower index.
-    #[inline]
-    fn before(&self, a: u32, b: u32) -> bool {
-        let (ta, tb) = (self.time[a as usize], self.time[b as usize]);
-        ta < tb || (ta == tb && a < b)
-    }
-
+    /// Puts `ball`, whose time is set, into the heap; rebuilds the heap from its live
+    /// entries when the dead ones outnumber them.
     fn heap_push(&mut self, ball: u32) {
-        self.heap.push(ball);
-        let pos = self.heap.len() - 1;
-        self.slot[ball as usize] = Slot::Heap(pos as u32);
-        self.sift_up(pos);
-    }
-
-    fn heap_remove(&mut self, pos: usize) {
-        let last = self.heap.len() - 1;
-        if pos == last {
-            self.heap.pop();
-        } else {
-            self.heap.swap(pos, last);
-            let moved = self.heap[pos];
-            self.slot[moved as usize] = Slot::Heap(pos as u32);
-            self.heap.pop();
-            let pos = self.sift_up(pos);
-            self.sift_down(pos);
+        self.slot[ball as usize] = Slot::Heap;
+        self.heap_live += 1;
+        if self.heap.len() >= 2 * self.heap_live + 16 {
+            let (time, slot) = (&self.time, &self.slot);
+            self.heap.retain(|e| e.is_live(time, slot));
+            // A sorted array is a heap.
+            self.heap.sort_unstable_by(|a, b| {
+                if a.before(b) {
+                    core::cmp::Ordering::Less
+                } else if b.before(a) {
+                    core::cmp::Ordering::Greater
+                } else {
+                    core::cmp::Ordering::Equal
+                }
+            });
         }
-    }
-
-    fn sift_up(&mut self, mut pos: usize) -> usize {
+        let entry = Entry {
+            time: self.time[ball as usize],
+            ball,
+        };
+        // Sift up: move parents down until the entry's place is found.
+        let mut pos = self.heap.len();
+        self.heap.push(entry);
         while pos > 0 {
             let parent = (pos - 1) / 2;
-            if !self.before(self.heap[pos], self.heap[parent]) {
+            if !entry.before(&self.heap[parent]) {
                 break;
             }
-            self.swap_heap(pos, parent);
+            self.heap[pos] = self.heap[parent];
             pos = parent;
         }
-        pos
+        self.heap[pos] = entry;
     }
 
-    fn sift_down(&mut self, mut pos: usize) {
-        loop {
-            let (l, r) = (2 * pos + 1, 2 * pos + 2);
-            let mut best = pos;
-            if l < self.heap.len() && self.before(self.heap[l], self.heap[best]) {
-                best = l;
-            }
-            if r < self.heap.len() && self.before(self.heap[r], self.heap[best]) {
-                best = r;
-            }
-            if best == pos {
-                return;
-            }
-            self.swap_heap(pos, best);
-            pos = best;
+    /// Removes the heap's top entry.
+    fn heap_pop(&mut self) {
+        let Some(last) = self.heap.pop() else {
+            return;
+        };
+        let n = self.heap.len();
+        if n == 0 {
+            return;
         }
-    }
-
-    fn swap_heap(&mut self, a: usize, b: usize) {
-        self.heap.swap(a, b);
-        self.slot[self.heap[a] as usize] = Slot::Heap(a as u32);
-        self.slot[self.heap[b] as usize] = Slot::Heap(b as u32);
+        // Sift the last entry down from the top: move the earlier child up.
+        let mut pos = 0;
+        loop {
+            let l = 2 * pos + 1;
+            if l >= n {
+                break;
+            }
+            let child = if l + 1 < n && self.heap[l + 1].before(&self.heap[l]) {
+                l + 1
+            } else {
+                l
+            };
+            if !self.heap[child].before(&last) {
+                break;
+            }
+            self.heap[pos] = self.heap[child];
+            pos = child;
+        }
+        self.heap[pos] = last;
     }
 }
 
@@ -430,15 +492,35 @@ mod tests {
             c.schedule(ball, t);
         }
         assert_eq!(c.peek(), Some((1, 0.1)));
-        let top = c.upcoming(3).to_vec();
+        let top: Vec<usize> = c.upcoming(3).collect();
         assert_eq!(top[0], 1);
         assert!(
             top[1..].contains(&3),
             "the second event (ball 3) in {top:?}"
         );
-        assert_eq!(c.upcoming(10).len(), 5);
+        assert_eq!(c.upcoming(10).count(), 5);
         c.pop();
-        assert_eq!(c.upcoming(1), &[3]);
+        assert!(c.upcoming(1).eq([3]));
+    }
+
+    #[test]
+    fn rescheduling_within_the_current_bucket_does_not_pile_up_dead_entries() {
+        // Ball 1 keeps the heap's bucket open; ball 0 is rescheduled a thousand times
+        // within it, later each time (a cascade at one instant does this). Each
+        // rescheduling leaves a dead entry below the top; the heap is rebuilt from its
+        // live entries before they outnumber them much.
+        let mut c = Calendar::<f64>::new(3, 4, 1.0, 0.0);
+        c.schedule(1, 0.1);
+        c.schedule(2, 0.2);
+        assert_eq!(c.peek(), Some((1, 0.1)));
+        for k in 0..1000 {
+            c.schedule(0, 0.5 + 1e-6 * f64::from(k));
+            assert!(c.heap.len() <= 2 * 3 + 16, "{} entries", c.heap.len());
+        }
+        assert_eq!(c.pop(), Some((1, 0.1)));
+        assert_eq!(c.pop(), Some((2, 0.2)));
+        assert_eq!(c.pop(), Some((0, 0.5 + 1e-6 * 999.0)));
+        assert_eq!(c.pop(), None);
     }
 
     #[test]

@@ -132,7 +132,7 @@ impl<T: Real, const D: usize> CellLists<T, D> {
                     .period()
             }),
             inset: width.map(|w| w * T::lit(FACE_INSET).max(T::lit(16.0) * T::EPSILON)),
-            places: Vec::with_capacity(n),
+            places: crate::pages::with_capacity(n),
         };
         for (i, p) in positions.iter().enumerate() {
             let c: [i64; D] = core::array::from_fn(|k| {

@@ -41,6 +41,7 @@ use carom_toi::Direction;
 use nalgebra::Const;
 
 use crate::engine::{BallStates, Counters, EngineKind, Observer, SimError, Simulation};
+use crate::pages;
 use crate::plan::{BroadChoice, Plan};
 use crate::prefetch::prefetch;
 use crate::scene::{Inelastic, Scene, SceneError};
@@ -296,26 +297,24 @@ where
         let sign = direction.sign::<T>();
         let n = scene.balls.len();
         let balls = Balls {
-            motion: scene
-                .balls
-                .iter()
-                .map(|b| Motion {
+            motion: pages::filled(n, |i| {
+                let b = &scene.balls[i];
+                Motion {
                     pos: b.pos,
                     vel: b.vel * sign,
                     t_ref: T::zero(),
                     radius: b.radius,
-                })
-                .collect(),
-            props: scene
-                .balls
-                .iter()
-                .map(|b| Props {
+                }
+            }),
+            props: pages::filled(n, |i| {
+                let b = &scene.balls[i];
+                Props {
                     mass: b.mass,
                     restitution: b.restitution,
                     last_collision: -T::INFINITY,
                     spin: <Const<D> as Space<T, D>>::angular_zero(),
-                })
-                .collect(),
+                }
+            }),
             accel: vec![scene.world.gravity; n],
             accelerated: scene.world.gravity != Vector::<T, D>::zeros(),
             count: vec![0; n],
@@ -494,8 +493,7 @@ where
                 prefetch(&self.balls.motion[p]);
             });
         }
-        for &b in self.calendar.upcoming(3) {
-            let b = b as usize;
+        for b in self.calendar.upcoming(3) {
             if b >= n {
                 continue;
             }
@@ -510,10 +508,9 @@ where
         }
         // The next collision's partner, and the states of the next ball's partners (its
         // pending event and list were asked for at the previous event, most likely).
-        if let Some(&b) = self.calendar.upcoming(1).first()
-            && (b as usize) < n
+        if let Some(b) = self.calendar.upcoming(1).next()
+            && b < n
         {
-            let b = b as usize;
             if let Some(j) = self.due_partner(b) {
                 prefetch(&self.balls.motion[j]);
                 prefetch(&self.balls.props[j]);

@@ -52,14 +52,11 @@ impl<const W: usize, A: Copy> IdRows<W, A> {
     /// `n` empty lists.
     pub(crate) fn new(n: usize) -> Self {
         Self {
-            rows: vec![
-                Row {
-                    align: [],
-                    len: 0,
-                    ids: [0; W]
-                };
-                n
-            ],
+            rows: crate::pages::filled(n, |_| Row {
+                align: [],
+                len: 0,
+                ids: [0; W],
+            }),
             spill: vec![Vec::new(); n],
         }
     }
