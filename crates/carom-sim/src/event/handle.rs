@@ -12,7 +12,7 @@
 //! [`SustainedContact`](crate::SimErrorKind::SustainedContact) error, which
 //! `--engine auto` hands over to the stepped engine: balls resting on each other or
 //! sinking into each other under gravity, a ball held between two surfaces or on an
-//! edge.
+//! edge, a ball wedged in flight between surfaces that it meets in turn ever faster.
 
 use carom_geometry::query::PointQuery;
 use carom_math::{Real, Space, Vector};
@@ -524,7 +524,7 @@ where
             border.min()[axis]
         };
         let support = Some(Support::Wall { axis, upper });
-        self.refuse_cornered(i, support)?;
+        self.refuse_cornered(i, support, Surface::Wall { axis, upper })?;
         if self.bounce(
             i,
             normal,
@@ -570,7 +570,7 @@ where
             axis: outside.1,
             upper: local[outside.1] > T::zero(),
         });
-        self.refuse_cornered(i, support)?;
+        self.refuse_cornered(i, support, Surface::Box(k))?;
         if self.bounce(i, normal, point, b.vel, b.restitution, support)? {
             self.counters.ball_box += 1;
             observer.collision(&Collision::BallBox {
@@ -582,30 +582,70 @@ where
         Ok(())
     }
 
-    /// An error if ball `i`, resting on a surface under gravity, meets another surface
-    /// (`support`, the face it meets, or `None` for an edge or a corner) soon after the
-    /// last time ([`Self::refuse_held`]): it is held between the two, which this engine
-    /// cannot resolve (it rests a ball on one surface). Fuzzed (3D, friction 0.3): a
-    /// spinning ball in the corner of the floor and a wall, pushed into the wall by the
-    /// floor's friction and lifted off the floor by the wall's, met them in turn 14
-    /// million times in 0.2 s, each round a little shorter.
-    fn refuse_cornered(&mut self, i: usize, support: Option<Support>) -> Result<(), SimError> {
+    /// An error if ball `i`, under gravity, is held between two surfaces: resting on one
+    /// and meeting another (`support`, the face it meets, or `None` for an edge or a
+    /// corner; `surface` names the wall or box) soon after the last time
+    /// ([`Self::refuse_held`]), or, in flight, meeting surfaces that take turns ever
+    /// faster ([`Self::refuse_wedged`]). This engine cannot resolve either (it rests a
+    /// ball on one surface). Fuzzed (3D, friction 0.3): a spinning ball in the corner of
+    /// the floor and a wall, pushed into the wall by the floor's friction and lifted off
+    /// the floor by the wall's, met them in turn 14 million times in 0.2 s, each round a
+    /// little shorter.
+    fn refuse_cornered(
+        &mut self,
+        i: usize,
+        support: Option<Support>,
+        surface: Surface,
+    ) -> Result<(), SimError> {
         if !self.balls.accelerated {
             return Ok(());
         }
-        let Mode::Resting(resting_on) = self.balls.mode[i] else {
-            return Ok(());
+        match self.balls.mode[i] {
+            Mode::Resting(resting_on) if support != Some(resting_on) => self.refuse_held(i, || {
+                format!(
+                    "ball {i} rests on {} and is held against {} (a corner or a wedge)",
+                    describe(Some(resting_on)),
+                    describe(support),
+                )
+            }),
+            Mode::Free => self.refuse_wedged(i, surface),
+            _ => Ok(()),
+        }
+    }
+
+    /// An error if free ball `i` meets surfaces (border walls, boxes) [`WEDGED_REPEATS`]
+    /// times in a row, each a different one from the last and within the resting
+    /// guard's shortest flight of it: it is wedged between them (squeezed by a moving
+    /// box, or held in a corner it cannot rest in), in flight only at the resolution of
+    /// its position. Fuzzed 2D scene run backwards (z40, 5e4 m from the origin): a ball
+    /// between the border, a static box and a box moving into them met the three in turn
+    /// every 1.2e-12 s, 37 million times in 20 s of computing, the run all but stopped.
+    /// Squeezes that resolve take far fewer (a box's corner squeezing a ball out of a
+    /// corner: tens of contacts).
+    fn refuse_wedged(&mut self, i: usize, surface: Surface) -> Result<(), SimError> {
+        let repeats = match self.wedged {
+            Some((ball, t, last, n))
+                if ball == i
+                    && last != surface
+                    && self.now - t < self.resting.min_flight_time() =>
+            {
+                n + 1
+            }
+            _ => 1,
         };
-        if support == Some(resting_on) {
+        self.wedged = Some((i, self.now, surface, repeats));
+        if repeats < WEDGED_REPEATS {
             return Ok(());
         }
-        self.refuse_held(i, || {
+        Err(SimError::sustained_contact(
+            (self.now * self.sign).to_f64(),
             format!(
-                "ball {i} rests on {} and is held against {} (a corner or a wedge)",
-                describe(Some(resting_on)),
-                describe(support),
-            )
-        })
+                "ball {i} is wedged: it met {} surfaces in a row, each a different one from the last within {:e} s, the last {}: sustained contact, which the event engine cannot resolve; the stepped engine simulates it (--engine auto hands the run over to it)",
+                repeats,
+                self.resting.min_flight_time().to_f64(),
+                surface.describe(),
+            ),
+        ))
     }
 
     /// An error if ball `i` is held where this engine cannot rest it (between two
@@ -644,6 +684,29 @@ where
 /// How many times in a row, each soon after the last, a ball may be held where the
 /// event engine cannot rest it before the run ends ([`EventEngine::refuse_held`]).
 const HELD_REPEATS: u32 = 64;
+
+/// How many surface contacts in a row, each soon after the last and with a different
+/// surface, a free ball may make before the run ends ([`EventEngine::refuse_wedged`]):
+/// far more than a squeeze that resolves takes, a few microseconds of computing.
+const WEDGED_REPEATS: u32 = 4096;
+
+/// A wall or a box a ball meets (which feature of a box does not matter).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Surface {
+    /// A border wall.
+    Wall { axis: usize, upper: bool },
+    /// Box `k`.
+    Box(usize),
+}
+
+impl Surface {
+    fn describe(self) -> String {
+        match self {
+            Self::Wall { axis, upper } => describe(Some(Support::Wall { axis, upper })),
+            Self::Box(k) => format!("boxes[{k}]"),
+        }
+    }
+}
 
 /// A surface a ball meets, named for a message: a face that can hold it, or (`None`) an
 /// edge or a corner of a box.

@@ -249,6 +249,10 @@ where
     /// The last ball held where this engine cannot rest it (between two surfaces, on an
     /// edge), when, and how many times in a row (`refuse_held`).
     held: Option<(usize, T, u32)>,
+    /// The free ball that last met a wall or a box under gravity, when, which, and how
+    /// many such contacts it has made in a row, each with a different surface soon
+    /// after the last (`handle.rs`, `refuse_wedged`).
+    wedged: Option<(usize, T, handle::Surface, u32)>,
     /// The most events at one instant before a cascade is declared endless.
     events_allowed_at_one_instant: usize,
     pipeline: Vec<String>,
@@ -367,6 +371,7 @@ where
             instant_width: instant_width(scene, scale),
             resting_pair: None,
             held: None,
+            wedged: None,
             events_allowed_at_one_instant: events_allowed_at_one_instant(
                 scene.balls.iter().map(|b| b.mass),
             ),
