@@ -1116,52 +1116,7 @@ fn a_ball_pressed_onto_another_never_sinks_into_it() {
 /// A fuzzed 2D scene (z40) run backwards, 5e4 m from the origin: ball 3 ends up between
 /// the border, a static box and a box moving into them, and met the three in turn every
 /// 1.2e-12 s, a crawl (37 million events in 20 s of computing).
-const WEDGE_SCENE: &str = r"dim = 2
-[world]
-gravity = [0.0, -9.81]
-restitution = 0.5
-[world.border]
-min = [-50000.5, -50000.5]
-max = [-49999.5, -49999.5]
-restitution = 0.9
-[[balls]]
-pos = [-49999.853065536045, -50000.48253415595]
-vel = [1.7298032183714076, 0.0]
-radius = 0.017465844052181212
-mass = 1.0
-[[balls]]
-pos = [-50000.28131554645, -49999.60639177917]
-vel = [-0.9124200773671451, -0.335810986951678]
-radius = 0.030724595830287138
-mass = 1.0
-[[balls]]
-pos = [-50000.05835795372, -50000.4402431738]
-vel = [0.5570941604513946, 0.0]
-radius = 0.059756826198464376
-mass = 1.0
-[[balls]]
-pos = [-49999.76252689534, -49999.71166549981]
-vel = [-1.7240279017391535, -0.3790939794202681]
-radius = 0.02251231636741461
-mass = 1.0
-[[boxes]]
-center = [-49999.63700247515, -50000.041352268985]
-half_extents = [0.19958573344040514, 0.0874893257522248]
-angle = -0.8634723902089372
-vel = [0.0, 0.0]
-restitution = 0.5
-[[boxes]]
-center = [-50000.16566409774, -50000.068150720355]
-half_extents = [0.051205253878453455, 0.09909445317917163]
-angle = -0.5407982554433812
-vel = [-0.8267710162246147, -0.23255154110455667]
-restitution = 0.5
-[[boxes]]
-center = [-49999.9443062738, -50000.074182555785]
-half_extents = [0.13404395532766414, 0.024091925803927675]
-angle = -0.46922471078892125
-vel = [0.0, 0.0]
-restitution = 0.5";
+const WEDGE_SCENE: &str = include_str!("scenes/corner_crush.toml");
 
 #[test]
 fn a_ball_wedged_between_surfaces_ends_the_run_as_sustained_contact_not_a_crawl() {

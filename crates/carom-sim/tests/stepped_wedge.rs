@@ -12,16 +12,18 @@
 
 mod common;
 
+use carom_geometry::query::PointQuery;
 use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;
 use carom_math::{Space, Vector};
 use carom_sim::observe::energy;
+use carom_sim::plan::BroadChoice;
 use carom_sim::plan::{RunOptions, plan};
 use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, LoadedScene, Scene, World, parse_scene};
 use carom_sim::stepped::StepStats;
 use carom_sim::{BallStates, EngineKind, EventEngine, Simulation};
 use carom_toi::Direction;
-use common::{states, stepped};
+use common::{states, stepped, stepped_with};
 use nalgebra::{Const, Vector2, Vector3};
 
 const DT: f64 = 0.01;
@@ -396,5 +398,55 @@ fn a_plank_squeezing_a_ball_into_its_neighbour_on_the_floor_moves_both_whatever_
                 );
             }
         }
+    }
+}
+
+/// A fuzzed 2D scene (z40) 5e4 m from the origin, run backwards: at t = −0.75654 s a box
+/// moving at 0.86 m/s presses ball 3 into the corner between the border's right wall and
+/// a static box. The three contact normals surround the ball and the moving box closes
+/// along its own: no velocity of the ball keeps all three from closing (checked on the
+/// event engine's state 1.3e-5 s before: the best one still closes a contact at
+/// 0.35 m/s), a crush. Its contacts came every 1.2e-12 s, never 256 within one instant
+/// of `1e-9 h`, so the wedge's hold never came, and the ball sank 13 mm into the moving
+/// box by t = −0.8 s with every integrator. A chain of contacts each within the time its
+/// bodies take to move by the coordinates' resolution now holds it, and the hold finds
+/// the crush, whatever the step and however samples cut it.
+const CORNER_CRUSH: &str = include_str!("scenes/corner_crush.toml");
+
+#[test]
+fn a_ball_pressed_into_a_corner_by_a_moving_box_is_named_crushed_not_let_into_the_box() {
+    let LoadedScene::D2(s) = parse_scene(CORNER_CRUSH).unwrap() else {
+        panic!("a 2D scene")
+    };
+    let moving = &s.boxes[1];
+    for (integrator, dt, sample) in [
+        (Integrator::SemiImplicitEuler, 1.0 / 600.0, 0.1),
+        (Integrator::SemiImplicitEuler, 1.0 / 600.0, 1e-3),
+        (Integrator::SemiImplicitEuler, 0.01, 1e-3),
+        (Integrator::ExplicitEuler, 1.0 / 600.0, 1e-3),
+        (Integrator::VelocityVerlet, 1.0 / 600.0, 1e-3),
+        (Integrator::Rk4, 1e-4, 1e-3),
+    ] {
+        let what = format!("{integrator:?}, dt {dt}, samples every {sample} s");
+        let mut sim = stepped_with(&s, integrator, dt, BroadChoice::Auto, Direction::Backward);
+        let mut end = None;
+        for k in 1..=(0.8_f64 / sample).round() as u32 {
+            let t = -sample * f64::from(k);
+            if let Err(e) = sim.advance_to(t, &mut ()) {
+                end = Some(e);
+                break;
+            }
+            let st = states(&sim);
+            let shape = moving.shape.translated(&(moving.vel * t));
+            let gap = shape.signed_distance_to_point(&st.pos[3]) - s.balls[3].radius;
+            assert!(
+                gap >= -1e-9,
+                "{what}, t = {t}: ball 3 {:e} m into the box",
+                -gap
+            );
+        }
+        let e = end.unwrap_or_else(|| panic!("{what}: the ball is crushed"));
+        assert!(e.message.contains("balls[3] is crushed"), "{what}: {e}");
+        assert!((e.time + 0.756_543).abs() < 1e-5, "{what}: {e}");
     }
 }

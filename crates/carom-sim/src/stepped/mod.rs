@@ -676,9 +676,24 @@ where
     fn note_contacts(&mut self, e: &Event<T, D>, h: T, t0: T) -> Result<bool, SimError> {
         let [i, other] = e.balls();
         let instant = h * T::lit(1e-9);
-        let mut repeat = self.repeats.note(i, e.time, instant);
+        // A chain's link: also the time in which the contact's bodies move by no more
+        // than the resolution of their coordinates (a squeeze far from the origin answers
+        // its contacts that far apart, whatever the step).
+        let speed = self.balls.chord[i].norm()
+            + match e.target {
+                Target::Ball(j) => self.balls.chord[j as usize].norm(),
+                Target::Box(k) => self.boxes.vel[k as usize].norm(),
+                Target::Border => T::zero(),
+            };
+        let resolution = crate::event::coordinate_resolution(self.balls.seg_x[i].amax());
+        let link = if speed > T::zero() {
+            instant.max(resolution / speed)
+        } else {
+            instant
+        };
+        let mut repeat = self.repeats.note(i, e.time, instant, link);
         if other != i {
-            repeat = repeat.max(self.repeats.note(other, e.time, instant));
+            repeat = repeat.max(self.repeats.note(other, e.time, instant, link));
         }
         if repeat == Repeat::Crushed {
             let by = match e.target {

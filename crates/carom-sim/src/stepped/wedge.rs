@@ -15,6 +15,15 @@
 //! squeezed between heavy ones (a 1 mg ball between two 1 kg balls and a floor), which
 //! one contact at a time passes on a millionth of the push per contact.
 //!
+//! Contacts that answer each other need not fall within one instant of the step: far
+//! from the origin a squeeze answers them as far apart as its bodies take to move by the
+//! resolution of their coordinates (a ball pressed by a moving box into a corner 5e4 m
+//! from the origin met its three surfaces in turn every 1.2e-12 s, never 256 within
+//! `1e-9 h`, and sank 13 mm into the box over a few steps). So a ball is wedged too when
+//! more than [`WEDGE_CONTACTS`] contacts follow each other, each within a *link* of the
+//! one before: the instant, or the time its contact's bodies take to move by that
+//! resolution, whichever is longer.
+//!
 //! No impulse frees a ball **crushed** by a kinematic box against the border, a static
 //! box or another kinematic box when the surfaces close on it from every side it could
 //! leave by (a box coming down parallel to the floor, or into a corner): the contacts
@@ -50,6 +59,10 @@ pub(crate) enum Repeat {
 pub(crate) struct Repeats<T> {
     anchor: Vec<T>,
     count: Vec<u32>,
+    /// The time of each ball's last contact, and how many it has had in a chain, each
+    /// within the chain's instant of the one before.
+    last: Vec<T>,
+    chain: Vec<u32>,
     /// The balls with a non-zero count (to forget in [`Self::clear`]).
     noted: Vec<u32>,
 }
@@ -60,6 +73,8 @@ impl<T: Real> Repeats<T> {
         Self {
             anchor: vec![T::zero(); n],
             count: vec![0; n],
+            last: vec![T::zero(); n],
+            chain: vec![0; n],
             noted: Vec::new(),
         }
     }
@@ -68,26 +83,38 @@ impl<T: Real> Repeats<T> {
     pub(crate) fn clear(&mut self) {
         for &i in &self.noted {
             self.count[i as usize] = 0;
+            self.chain[i as usize] = 0;
         }
         self.noted.clear();
     }
 
     /// Notes a contact of ball `i` at in-step time `s` and tells what its contacts within
-    /// `tolerance` of the first of them say. A contact further away starts a new instant.
-    pub(crate) fn note(&mut self, i: usize, s: T, tolerance: T) -> Repeat {
-        let count = &mut self.count[i];
-        if *count == 0 {
+    /// `tolerance` of the first of them say (a contact further away starts a new
+    /// instant), and its chain of contacts each within `link` of the one before: a chain
+    /// longer than [`WEDGE_CONTACTS`] wedges it too.
+    pub(crate) fn note(&mut self, i: usize, s: T, tolerance: T, link: T) -> Repeat {
+        let fresh = self.count[i] == 0;
+        if fresh {
             self.noted.push(i as u32);
         }
-        if *count == 0 || (s - self.anchor[i]).abs() > tolerance {
+        let count = &mut self.count[i];
+        if fresh || (s - self.anchor[i]).abs() > tolerance {
             self.anchor[i] = s;
             *count = 1;
         } else {
             *count = count.saturating_add(1);
         }
-        match *count {
-            c if c > CRUSH_CONTACTS => Repeat::Crushed,
-            c if c > WEDGE_CONTACTS => Repeat::Wedged,
+        let count = *count;
+        let chain = &mut self.chain[i];
+        if fresh || (s - self.last[i]).abs() > link {
+            *chain = 1;
+        } else {
+            *chain = chain.saturating_add(1);
+        }
+        self.last[i] = s;
+        match (count, *chain) {
+            (c, _) if c > CRUSH_CONTACTS => Repeat::Crushed,
+            (c, k) if c > WEDGE_CONTACTS || k > WEDGE_CONTACTS => Repeat::Wedged,
             _ => Repeat::Free,
         }
     }
@@ -102,15 +129,15 @@ mod tests {
         let mut r = Repeats::<f64>::new(2);
         for k in 0..WEDGE_CONTACTS {
             let s = 0.5 + f64::from(k) * 1e-15;
-            assert_eq!(r.note(0, s, 1e-9), Repeat::Free, "contact {k}");
+            assert_eq!(r.note(0, s, 1e-9, 1e-9), Repeat::Free, "contact {k}");
         }
         for k in WEDGE_CONTACTS..CRUSH_CONTACTS {
             let s = 0.5 + f64::from(k) * 1e-15;
-            assert_eq!(r.note(0, s, 1e-9), Repeat::Wedged, "contact {k}");
+            assert_eq!(r.note(0, s, 1e-9, 1e-9), Repeat::Wedged, "contact {k}");
         }
-        assert_eq!(r.note(0, 0.5 + 1e-12, 1e-9), Repeat::Crushed);
+        assert_eq!(r.note(0, 0.5 + 1e-12, 1e-9, 1e-9), Repeat::Crushed);
         // The other ball has its own count.
-        assert_eq!(r.note(1, 0.5, 1e-9), Repeat::Free);
+        assert_eq!(r.note(1, 0.5, 1e-9, 1e-9), Repeat::Free);
     }
 
     #[test]
@@ -118,12 +145,36 @@ mod tests {
         let mut r = Repeats::<f64>::new(1);
         // A ball rattling between walls: many contacts, each one instant apart.
         for k in 0..2 * CRUSH_CONTACTS {
-            assert_eq!(r.note(0, f64::from(k) * 1e-6, 1e-9), Repeat::Free);
+            assert_eq!(r.note(0, f64::from(k) * 1e-6, 1e-9, 1e-9), Repeat::Free);
         }
         for _ in 0..WEDGE_CONTACTS {
-            r.note(0, 0.25, 1e-9);
+            r.note(0, 0.25, 1e-9, 1e-9);
         }
         r.clear();
-        assert_eq!(r.note(0, 0.25, 1e-9), Repeat::Free);
+        assert_eq!(r.note(0, 0.25, 1e-9, 1e-9), Repeat::Free);
+    }
+
+    #[test]
+    fn a_chain_of_contacts_each_within_a_link_of_the_last_wedges_the_ball() {
+        // Contacts 1.2e-12 apart, never two within an instant of 1e-12 of the first of
+        // them: free one at a time, wedged once the chain's links (1e-10) hold them.
+        let mut separate = Repeats::<f64>::new(1);
+        let mut chained = Repeats::<f64>::new(1);
+        for k in 0..4 * WEDGE_CONTACTS {
+            let s = 0.5 + f64::from(k) * 1.2e-12;
+            assert_eq!(
+                separate.note(0, s, 1e-12, 1e-12),
+                Repeat::Free,
+                "contact {k}"
+            );
+            let expected = if k < WEDGE_CONTACTS {
+                Repeat::Free
+            } else {
+                Repeat::Wedged
+            };
+            assert_eq!(chained.note(0, s, 1e-12, 1e-10), expected, "contact {k}");
+        }
+        // A chain never crushes on its own: that takes contacts at one instant.
+        assert_eq!(chained.note(0, 0.5 + 1e-6, 1e-12, 1e-3), Repeat::Wedged);
     }
 }
