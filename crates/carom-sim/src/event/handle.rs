@@ -640,7 +640,7 @@ where
         Err(SimError::sustained_contact(
             (self.now * self.sign).to_f64(),
             format!(
-                "ball {i} is wedged: it met {} surfaces in a row, each a different one from the last within {:e} s, the last {}: sustained contact, which the event engine cannot resolve; the stepped engine simulates it (--engine auto hands the run over to it)",
+                "ball {i} is wedged: {} contacts with walls and boxes in a row, each with a different one from the last and within {:e} s of it, the last with {}: sustained contact, which the event engine cannot resolve; the stepped engine simulates it (--engine auto hands the run over to it)",
                 repeats,
                 self.resting.min_flight_time().to_f64(),
                 surface.describe(),
@@ -687,7 +687,7 @@ const HELD_REPEATS: u32 = 64;
 
 /// How many surface contacts in a row, each soon after the last and with a different
 /// surface, a free ball may make before the run ends ([`EventEngine::refuse_wedged`]):
-/// far more than a squeeze that resolves takes, a few microseconds of computing.
+/// far more than a squeeze that resolves takes, and a few milliseconds of computing.
 const WEDGED_REPEATS: u32 = 4096;
 
 /// A wall or a box a ball meets (which feature of a box does not matter).
