@@ -2,7 +2,7 @@
 //!
 //! Scenes (carom-sim's shared gas generator): 3D hard spheres in a periodic box at
 //! packing fraction 0.45 (N = 32,000: the target, beside Smallenburg's EDMD,
-//! measured at 0.80–0.86 M collisions/s on this project's VM, docs/event-engine.md) and
+//! measured at 0.78–0.80 M collisions/s on this project's current VM, docs/event-engine.md) and
 //! 2D discs at area fraction 0.3
 //! (N = 100,000). Each gas is first run for two time units so the lattice start has
 //! relaxed; then each criterion iteration advances it by a fixed time span whose

@@ -29,13 +29,16 @@ pub const EVENT_3D: f64 = 6e5;
 /// … at this many spheres.
 pub const EVENT_3D_N: usize = 32_000;
 /// Smallenburg's EDMD ("Single", the published code), 3D hard spheres, N = 32,000 at
-/// packing fraction 0.45, collisions per second on one core (low, high): measured on this
-/// project's 2-core VM on 2026-11-24, its `-O3` and `-Ofast -march=native` builds without
-/// the thermostat, five runs each alternated with carom's (docs/event-engine.md). The
-/// issue quoted 0.35–0.42 M/s for its machine; this one runs EDMD twice as fast. The
-/// report cannot build EDMD itself (its code is not part of carom), so the figure is a
-/// constant with its date.
-pub const EDMD: (f64, f64) = (0.80e6, 0.86e6);
+/// packing fraction 0.45, collisions per second on one core (low, high): the medians of
+/// its `-Ofast -march=native` and `-O3` builds without the thermostat, measured on this
+/// project's current 2-core VM (an Intel Xeon) on 2026-11-25, five runs each alternated
+/// with carom's (docs/event-engine.md; 0.80–0.86 M/s on the previous VM, an AMD EPYC,
+/// 2026-11-24). The issue quoted 0.35–0.42 M/s for its machine. The report cannot build
+/// EDMD itself (its code is not part of carom), so the figure is a constant with its
+/// date.
+pub const EDMD: (f64, f64) = (0.78e6, 0.80e6);
+/// When [`EDMD`] was measured.
+pub const EDMD_MEASURED: &str = "2026-11-25";
 /// A coherent broad-phase frame, nanoseconds per ball on one thread …
 pub const BROAD_COHERENT_NS: f64 = 40.0;
 /// … at this many balls; the broad phases' 2-thread speedup target is at the same size.
