@@ -82,10 +82,14 @@ where
         })
     }
 
-    /// Builds the stepped engine from `event`'s state at the instant of `error`, or gives
-    /// the error back if it cannot take the run on.
+    /// Builds the stepped engine for `scene` (as given, at time 0; its broad phase
+    /// `broad`, run `direction`) from `event`'s state at the instant of `error`, or gives
+    /// the error back if it cannot take the run on. Not a method: the run's stage, which
+    /// holds `event`, is borrowed meanwhile.
     fn switch_to_stepped(
-        &self,
+        scene: &Scene<T, D>,
+        broad: BroadChoice,
+        direction: Direction,
         event: &EventEngine<T, D>,
         error: SimError,
     ) -> Result<Shifted<T, D>, SimError> {
@@ -101,14 +105,14 @@ where
         };
         let mut states = BallStates::default();
         event.states(&mut states);
-        let scene = scene_at(&self.scene, start, &states);
+        let scene = scene_at(scene, start, &states);
         let options = RunOptions {
             engine: EngineChoice::Stepped,
-            broad: self.broad,
+            broad,
             ..RunOptions::default()
         };
         let stepped_plan = plan(&scene, &options).map_err(|e| failed(e.0))?;
-        let engine = SteppedEngine::continuing(&scene, &stepped_plan, self.direction, &states.spin)
+        let engine = SteppedEngine::continuing(&scene, &stepped_plan, direction, &states.spin)
             .map_err(|e| failed(e.to_string()))?;
         Ok(Shifted {
             engine,
@@ -192,10 +196,9 @@ where
         if let Stage::Event(event) = &mut self.stage {
             match event.advance_to(target, observer) {
                 Err(e) if e.kind == SimErrorKind::SustainedContact => {
-                    let Stage::Event(event) = &self.stage else {
-                        unreachable!("the event stage")
-                    };
-                    self.stage = Stage::Stepped(Box::new(self.switch_to_stepped(event, e)?));
+                    let shifted =
+                        Self::switch_to_stepped(&self.scene, self.broad, self.direction, event, e)?;
+                    self.stage = Stage::Stepped(Box::new(shifted));
                 }
                 done => return done,
             }

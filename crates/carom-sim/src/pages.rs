@@ -1,10 +1,11 @@
 //! Large per-ball arrays backed by huge pages where the system allows it.
 //!
 //! The event-driven engine reads a few records of random balls at every event: at 1e5
-//! balls its arrays (records, cells, calendar) span tens of megabytes, and with 4 KiB
-//! pages nearly every such read also misses the processor's address-translation cache
-//! (its second level covers a few megabytes). Backed by 2 MiB pages the same arrays need
-//! a few dozen translations. Linux hands out such pages for memory a program marks
+//! balls its arrays (records, cells, calendar) span tens of megabytes: in 4 KiB pages,
+//! thousands of translations, far more than the processor's address-translation cache
+//! holds (its second level covers a few megabytes), so random reads there also walk the
+//! page tables. Backed by 2 MiB pages the same arrays need a few dozen translations (the
+//! gain measured, not the misses: this VM exposes no hardware counters). Linux hands out such pages for memory a program marks
 //! with `madvise(MADV_HUGEPAGE)` (the kernel's transparent huge pages in their default
 //! `madvise` mode; in `always` mode it does so anyway, in `never` mode not at all), and
 //! only when the memory is first written after the mark. So the arrays here are

@@ -22,9 +22,9 @@ use carom_response::{
 use nalgebra::Const;
 
 use super::state::{Mode, Support};
-use super::{EventEngine, Partners, Pending, coordinate_resolution};
+use super::{EventEngine, Partners, Pending};
 use crate::engine::{Collision, Observer, SimError};
-use crate::scene::OVERLAP_TOLERANCE;
+use crate::scene::{OVERLAP_TOLERANCE, coordinate_resolution};
 
 impl<T: Real, const D: usize> EventEngine<T, D>
 where
@@ -300,14 +300,14 @@ where
         if overlap <= allowed {
             return Ok(());
         }
-        Err(SimError::sustained_contact(
-            (self.now * self.sign).to_f64(),
-            format!(
-                "balls {} and {} are pressed into each other under gravity (they overlap by {:.3e} m): sustained contact (a ball resting on another), which the event engine cannot resolve; the stepped engine simulates it (--engine auto hands the run over to it)",
+        Err(self.sustained(
+            &format!(
+                "balls {} and {} are pressed into each other under gravity (they overlap by {:.3e} m)",
                 i.min(j),
                 i.max(j),
                 overlap.to_f64()
             ),
+            " (a ball resting on another)",
         ))
     }
 
@@ -339,12 +339,12 @@ where
             self.resting_pair = Some((pair, self.now));
             return Ok(());
         }
-        Err(SimError::sustained_contact(
-            (self.now * self.sign).to_f64(),
-            format!(
-                "balls {} and {} rest on each other under gravity: sustained contact (a stack, a pile), which the event engine cannot resolve; the stepped engine simulates it (--engine auto hands the run over to it)",
+        Err(self.sustained(
+            &format!(
+                "balls {} and {} rest on each other under gravity",
                 pair.0, pair.1
             ),
+            " (a stack, a pile)",
         ))
     }
 
@@ -637,14 +637,14 @@ where
         if repeats < WEDGED_REPEATS {
             return Ok(());
         }
-        Err(SimError::sustained_contact(
-            (self.now * self.sign).to_f64(),
-            format!(
-                "ball {i} is wedged: {} contacts with walls and boxes in a row, each with a different one from the last and within {:e} s of it, the last with {}: sustained contact, which the event engine cannot resolve; the stepped engine simulates it (--engine auto hands the run over to it)",
+        Err(self.sustained(
+            &format!(
+                "ball {i} is wedged: {} contacts with walls and boxes in a row, each with a different one from the last and within {:e} s of it, the last with {}",
                 repeats,
                 self.resting.min_flight_time().to_f64(),
                 surface.describe(),
             ),
+            "",
         ))
     }
 
@@ -670,14 +670,26 @@ where
         if repeats < HELD_REPEATS {
             return Ok(());
         }
-        Err(SimError::sustained_contact(
-            (self.now * self.sign).to_f64(),
-            format!(
-                "{} ({repeats} times in a row, each within {:e} s of the last): sustained contact, which the event engine cannot resolve; the stepped engine simulates it (--engine auto hands the run over to it)",
+        Err(self.sustained(
+            &format!(
+                "{} ({repeats} times in a row, each within {:e} s of the last)",
                 what(),
                 self.resting.min_flight_time().to_f64()
             ),
+            "",
         ))
+    }
+
+    /// The error that ends the run at a sustained contact, now: `what` happened, which is
+    /// sustained contact (`example` names its kind, or is empty), with the remedy. Every
+    /// sustained-contact rule of this module words its error so.
+    fn sustained(&self, what: &str, example: &str) -> SimError {
+        SimError::sustained_contact(
+            (self.now * self.sign).to_f64(),
+            format!(
+                "{what}: sustained contact{example}, which the event engine cannot resolve; the stepped engine simulates it (--engine auto hands the run over to it)"
+            ),
+        )
     }
 }
 

@@ -44,7 +44,7 @@ use crate::engine::{BallStates, Counters, EngineKind, Observer, SimError, Simula
 use crate::pages;
 use crate::plan::{BroadChoice, Plan};
 use crate::prefetch::prefetch;
-use crate::scene::{Inelastic, Scene, SceneError};
+use crate::scene::{Inelastic, Scene, SceneError, coordinate_resolution};
 use calendar::Calendar;
 use cells::CellLists;
 use cluster::ClusterBody;
@@ -710,14 +710,6 @@ fn instant_width<T: Real, const D: usize>(scene: &Scene<T, D>, length_scale: T) 
         .max((T::lit(2.0) * scene.world.gravity.norm() * length_scale).sqrt());
     let width = coordinate_resolution(length_scale) / speed;
     if width.finite() { width } else { T::zero() }
-}
-
-/// The resolution of a coordinate of magnitude `x`: `8 ε x` (`ε` the machine epsilon,
-/// two unit roundoffs), sixteen roundings. A length or a rise below it is not seen by
-/// positions of that size (the resting guard's height floor, the lift of a bounce, the
-/// width of an instant).
-pub(crate) fn coordinate_resolution<T: Real>(x: T) -> T {
-    T::lit(8.0) * T::EPSILON * x
 }
 
 /// The size of a scene: the largest border extent, or the spread of the balls.

@@ -14,6 +14,7 @@ use carom_geometry::{Border, Obb};
 use carom_math::{Real, Vector};
 
 pub use file::{LoadedScene, load_scene_file, parse_scene};
+pub(crate) use validate::coordinate_resolution;
 pub use validate::{OVERLAP_TOLERANCE, SceneError};
 
 /// What restitution 0 means between two balls.

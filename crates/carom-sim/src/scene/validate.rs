@@ -21,6 +21,14 @@ use super::Scene;
 /// overlaps up to this are accepted as rounding in hand-written files.
 pub const OVERLAP_TOLERANCE: f64 = 1e-9;
 
+/// The resolution of a coordinate of magnitude `x`: `8 ε x` (`ε` the machine epsilon,
+/// two unit roundoffs), sixteen roundings. A length or a rise below it is not seen by
+/// positions of that size (the resting guard's height floor, the lift of a bounce, the
+/// width of an instant, the link of a stepped contact chain): both engines read it.
+pub(crate) fn coordinate_resolution<T: Real>(x: T) -> T {
+    T::lit(8.0) * T::EPSILON * x
+}
+
 /// A scene that breaks a rule of the contract: where, and what is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub struct SceneError {

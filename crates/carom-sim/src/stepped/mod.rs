@@ -685,7 +685,7 @@ where
                 Target::Box(k) => self.boxes.vel[k as usize].norm(),
                 Target::Border => T::zero(),
             };
-        let resolution = crate::event::coordinate_resolution(self.balls.seg_x[i].amax());
+        let resolution = crate::scene::coordinate_resolution(self.balls.seg_x[i].amax());
         let link = if speed > T::zero() {
             instant.max(resolution / speed)
         } else {

@@ -75,24 +75,13 @@ impl<T: Real> Observer<T> for Recorder<T> {
 
 /// A sink that keeps what [`carom_sim::run::drive`] hands it: every sample and, when
 /// asked for, every collision.
+#[derive(Default)]
 pub(crate) struct Keep<const D: usize>
 where
     Const<D>: Space<f64, D>,
 {
     pub(crate) samples: Vec<(f64, BallStates<f64, D>)>,
     pub(crate) collisions: Vec<Collision<f64>>,
-}
-
-impl<const D: usize> Default for Keep<D>
-where
-    Const<D>: Space<f64, D>,
-{
-    fn default() -> Self {
-        Self {
-            samples: Vec::new(),
-            collisions: Vec::new(),
-        }
-    }
 }
 
 impl<const D: usize> RunSink<f64, D> for Keep<D>
