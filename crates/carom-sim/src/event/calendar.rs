@@ -31,6 +31,8 @@
 
 use carom_math::{Real, floor_to_i64};
 
+use crate::pages::Array;
+
 const NONE: u32 = u32::MAX;
 
 /// Where a ball's event is stored.
@@ -72,11 +74,11 @@ impl<T: Real> Entry<T> {
 /// A calendar of at most one event per ball.
 #[derive(Clone, Debug)]
 pub struct Calendar<T: Real> {
-    time: Vec<T>,
-    slot: Vec<Slot>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
-    heads: Vec<u32>,
+    time: Array<T>,
+    slot: Array<Slot>,
+    next: Array<u32>,
+    prev: Array<u32>,
+    heads: Array<u32>,
     /// The current bucket's events, a binary min-heap ordered by (time, ball), dead
     /// entries included (see the module documentation).
     heap: Vec<Entry<T>>,
@@ -104,11 +106,11 @@ impl<T: Real> Calendar<T> {
         assert!(balls < NONE as usize, "at most 2^32 − 2 balls");
         let buckets = buckets.max(1);
         let mut c = Self {
-            time: vec![T::INFINITY; balls],
-            slot: vec![Slot::Idle; balls],
-            next: vec![NONE; balls],
-            prev: vec![NONE; balls],
-            heads: vec![NONE; buckets],
+            time: Array::filled(balls, |_| T::INFINITY),
+            slot: Array::filled(balls, |_| Slot::Idle),
+            next: Array::filled(balls, |_| NONE),
+            prev: Array::filled(balls, |_| NONE),
+            heads: Array::filled(buckets, |_| NONE),
             heap: Vec::with_capacity(64),
             heap_live: 0,
             overflow: Vec::new(),

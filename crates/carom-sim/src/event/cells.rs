@@ -34,6 +34,7 @@ use carom_toi::{Direction, Window, level_crossing};
 
 use super::grid::{GridIndex, MAX_AROUND};
 use super::rows::{IdRows, Quarter};
+use crate::pages::Array;
 use crate::prefetch::prefetch;
 
 /// Balls kept in a cell's row: a 16-byte row, four to a cache line, so the three cells
@@ -92,7 +93,7 @@ pub struct CellLists<T: Real, const D: usize> {
     /// The balls in each cell.
     members: IdRows<CELL_ROW, Quarter>,
     /// Each ball's cell and scheduled times.
-    places: Vec<Place<T, D>>,
+    places: Array<Place<T, D>>,
 }
 
 impl<T: Real, const D: usize> CellLists<T, D> {
@@ -132,25 +133,25 @@ impl<T: Real, const D: usize> CellLists<T, D> {
                     .period()
             }),
             inset: width.map(|w| w * T::lit(FACE_INSET).max(T::lit(16.0) * T::EPSILON)),
-            places: crate::pages::with_capacity(n),
-        };
-        for (i, p) in positions.iter().enumerate() {
-            let c: [i64; D] = core::array::from_fn(|k| {
-                let c = floor_to_i64((p[k] - min[k]) / width[k]);
-                if periodic {
-                    c.rem_euclid(counts[k])
-                } else {
-                    c.clamp(0, counts[k] - 1)
-                }
-            });
-            cells.members.push(cells.grid.index(c), i as u32);
-            cells.places.push(Place {
-                cell: c.map(|x| x as i32),
+            places: Array::filled(n, |i| Place {
+                cell: core::array::from_fn(|k| {
+                    let c = floor_to_i64((positions[i][k] - min[k]) / width[k]);
+                    let c = if periodic {
+                        c.rem_euclid(counts[k])
+                    } else {
+                        c.clamp(0, counts[k] - 1)
+                    };
+                    c as i32
+                }),
                 crossing: T::INFINITY,
                 event: T::INFINITY,
                 axis: 0,
                 upper: false,
-            });
+            }),
+        };
+        for i in 0..n {
+            let c = cells.places[i].cell.map(i64::from);
+            cells.members.push(cells.grid.index(c), i as u32);
         }
         cells
     }

@@ -41,7 +41,7 @@ use carom_toi::Direction;
 use nalgebra::Const;
 
 use crate::engine::{BallStates, Counters, EngineKind, Observer, SimError, Simulation};
-use crate::pages;
+use crate::pages::Array;
 use crate::plan::{BroadChoice, Plan};
 use crate::prefetch::prefetch;
 use crate::scene::{Inelastic, Scene, SceneError, coordinate_resolution};
@@ -233,7 +233,7 @@ where
     length_scale: T,
     partners: Partners<T, D>,
     calendar: Calendar<T>,
-    pending: Vec<Pending>,
+    pending: Array<Pending>,
     /// Internal (forward-running) time.
     now: T,
     counters: Counters,
@@ -301,7 +301,7 @@ where
         let sign = direction.sign::<T>();
         let n = scene.balls.len();
         let balls = Balls {
-            motion: pages::filled(n, |i| {
+            motion: Array::filled(n, |i| {
                 let b = &scene.balls[i];
                 Motion {
                     pos: b.pos,
@@ -310,7 +310,7 @@ where
                     radius: b.radius,
                 }
             }),
-            props: pages::filled(n, |i| {
+            props: Array::filled(n, |i| {
                 let b = &scene.balls[i];
                 Props {
                     mass: b.mass,
@@ -319,10 +319,10 @@ where
                     spin: <Const<D> as Space<T, D>>::angular_zero(),
                 }
             }),
-            accel: vec![scene.world.gravity; n],
+            accel: Array::filled(n, |_| scene.world.gravity),
             accelerated: scene.world.gravity != Vector::<T, D>::zeros(),
-            count: vec![0; n],
-            mode: vec![Mode::Free; n],
+            count: Array::filled(n, |_| 0),
+            mode: Array::filled(n, |_| Mode::Free),
         };
         let (border, border_restitution, periodic) = match &scene.world.border {
             Some(b) => (Some(b.border), b.restitution, b.periodic),
@@ -364,7 +364,7 @@ where
             clusters: Vec::new(),
             partners,
             calendar: Calendar::sized_for(slots, T::one(), T::zero()),
-            pending: vec![Pending::None; slots],
+            pending: Array::filled(slots, |_| Pending::None),
             now: T::zero(),
             counters: Counters::default(),
             events_at_instant: 0,
@@ -852,7 +852,7 @@ where
                 Vector::<T, D>::repeat(T::INFINITY),
                 Vector::<T, D>::repeat(-T::INFINITY),
             );
-            for m in &balls.motion {
+            for m in balls.motion.iter() {
                 lo = lo.inf(&m.pos);
                 hi = hi.sup(&m.pos);
             }

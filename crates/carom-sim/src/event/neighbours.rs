@@ -25,6 +25,7 @@ use carom_math::{Real, Vector, floor_to_i64};
 
 use super::grid::{GridIndex, MAX_AROUND};
 use super::rows::IdRows;
+use crate::pages::Array;
 use crate::prefetch::prefetch;
 
 /// Balls kept in a cell's row (a 64-byte row; a cell holds about 3 (2D) to 4 (3D) at the
@@ -86,8 +87,8 @@ pub struct NeighbourLists<T: Real, const D: usize> {
     /// The balls anchored in each cell.
     members: IdRows<CELL_ROW>,
     /// The cell of each ball's anchor.
-    cell_of: Vec<u32>,
-    balls: Vec<Anchored<T, D>>,
+    cell_of: Array<u32>,
+    balls: Array<Anchored<T, D>>,
     lists: IdRows<LIST_ROW>,
     /// A rebuild's candidates (scratch, kept to avoid an allocation per rebuild).
     candidates: Vec<u32>,
@@ -147,12 +148,11 @@ impl<T: Real, const D: usize> NeighbourLists<T, D> {
             cells,
             period,
             members: IdRows::new(table),
-            cell_of: vec![0; n],
-            balls: positions
-                .iter()
-                .zip(radii)
-                .map(|(&anchor, &radius)| Anchored { anchor, radius })
-                .collect(),
+            cell_of: Array::filled(n, |_| 0),
+            balls: Array::filled(n, |i| Anchored {
+                anchor: positions[i],
+                radius: radii[i],
+            }),
             lists: IdRows::new(n),
             candidates: Vec::new(),
         };

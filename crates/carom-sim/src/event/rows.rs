@@ -17,6 +17,7 @@
 //! grid's cells (linked lists through the balls before) they measured level and are kept
 //! because they are simpler (see `docs/event-engine.md`).
 
+use crate::pages::Array;
 use crate::prefetch::prefetch;
 
 /// Rows aligned to the cache line (64 bytes): a row is read with one miss.
@@ -43,7 +44,7 @@ struct Row<const W: usize, A> {
 /// module documentation).
 #[derive(Clone, Debug)]
 pub(crate) struct IdRows<const W: usize, A = Line> {
-    rows: Vec<Row<W, A>>,
+    rows: Array<Row<W, A>>,
     /// The ids beyond the row, per list (empty, never allocated, for most).
     spill: Vec<Vec<u32>>,
 }
@@ -52,7 +53,7 @@ impl<const W: usize, A: Copy> IdRows<W, A> {
     /// `n` empty lists.
     pub(crate) fn new(n: usize) -> Self {
         Self {
-            rows: crate::pages::filled(n, |_| Row {
+            rows: Array::filled(n, |_| Row {
                 align: [],
                 len: 0,
                 ids: [0; W],

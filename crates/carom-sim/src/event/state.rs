@@ -15,6 +15,7 @@ use carom_math::{Real, Space, Vector};
 use nalgebra::Const;
 
 use crate::engine::Angular;
+use crate::pages::Array;
 
 /// What holds a resting ball.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -75,15 +76,15 @@ pub(crate) struct Balls<T: Real, const D: usize>
 where
     Const<D>: Space<T, D>,
 {
-    pub(crate) motion: Vec<Motion<T, D>>,
-    pub(crate) props: Vec<Props<T, D>>,
+    pub(crate) motion: Array<Motion<T, D>>,
+    pub(crate) props: Array<Props<T, D>>,
     /// The acceleration of each ball (read only when `accelerated`).
-    pub(crate) accel: Vec<Vector<T, D>>,
+    pub(crate) accel: Array<Vector<T, D>>,
     /// `false` in a world without gravity, where every acceleration is zero: states are
     /// advanced without reading `accel`.
     pub(crate) accelerated: bool,
-    pub(crate) count: Vec<u32>,
-    pub(crate) mode: Vec<Mode>,
+    pub(crate) count: Array<u32>,
+    pub(crate) mode: Array<Mode>,
 }
 
 impl<T: Real, const D: usize> Balls<T, D>
