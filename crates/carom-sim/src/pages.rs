@@ -173,7 +173,16 @@ mod tests {
     fn filled_holds_the_values_asked_for_at_every_size() {
         // Around the threshold and the huge page's size in values of 8 and 64 bytes: the
         // allocation must not change what is written, or drop or add any value.
-        for n in [0, 1, LARGE / 8 - 1, LARGE / 8, 262_143, 262_144, 262_145, 600_000] {
+        for n in [
+            0,
+            1,
+            LARGE / 8 - 1,
+            LARGE / 8,
+            262_143,
+            262_144,
+            262_145,
+            600_000,
+        ] {
             let mut v = Array::filled(n, |i| i as u64 * 3 + 1);
             assert_eq!(v.len(), n);
             assert!(v.iter().enumerate().all(|(i, &x)| x == i as u64 * 3 + 1));

@@ -84,6 +84,9 @@ pub struct Calendar<T: Real> {
     heap: Vec<Entry<T>>,
     /// The number of live entries in the heap.
     heap_live: usize,
+    /// The ball whose successor in the next bucket's list is read ahead at the next pop
+    /// (`NONE`: nothing to read ahead; see [`Calendar::pop`]).
+    ahead: u32,
     overflow: Vec<u32>,
     /// The inverse of the bucket width.
     inv_width: T,
@@ -113,6 +116,7 @@ impl<T: Real> Calendar<T> {
             heads: Array::filled(buckets, |_| NONE),
             heap: Vec::with_capacity(64),
             heap_live: 0,
+            ahead: NONE,
             overflow: Vec::new(),
             inv_width: T::one() / width,
             current: 0,
@@ -221,6 +225,7 @@ impl<T: Real> Calendar<T> {
         let (ball, t) = self.peek()?;
         self.heap_pop();
         self.cancel(ball);
+        self.read_ahead();
         Some((ball, t))
     }
 
@@ -259,6 +264,12 @@ impl<T: Real> Calendar<T> {
                 if self.heads[b] != NONE {
                     self.current = k;
                     self.drain_bucket_into_heap(b);
+                    // Start reading ahead the next bucket's list.
+                    self.ahead = if k + 1 < self.cycle_end {
+                        self.heads[(k + 1).rem_euclid(nb) as usize]
+                    } else {
+                        NONE
+                    };
                     return;
                 }
                 k += 1;
@@ -280,6 +291,30 @@ impl<T: Real> Calendar<T> {
             if !self.heap.is_empty() {
                 return;
             }
+        }
+    }
+
+    /// One step along the next bucket's list: asks for the links, time and slot of the
+    /// ball after `ahead` to be brought into the cache, and moves `ahead` on to it.
+    ///
+    /// Emptying a bucket into the heap follows its list from ball to ball, each step a
+    /// read of a random ball's link that waits for the one before (4 % of the 2D gas's
+    /// time at 1e5 balls). A bucket holds about as many events as it takes pops to empty
+    /// the one before, so one step per pop has the next bucket's list in the cache when
+    /// the heap runs dry. The list may change meanwhile (a ball inserted at its head was
+    /// just written; one removed has no successor, which ends the walk; one moved to
+    /// another list leads the walk there): it is only a hint, and changes nothing.
+    #[inline]
+    fn read_ahead(&mut self) {
+        if self.ahead == NONE {
+            return;
+        }
+        let ball = self.ahead as usize;
+        crate::prefetch::prefetch(&self.time[ball]);
+        crate::prefetch::prefetch(&self.slot[ball]);
+        self.ahead = self.next[ball];
+        if self.ahead != NONE {
+            crate::prefetch::prefetch(&self.next[self.ahead as usize]);
         }
     }
 
