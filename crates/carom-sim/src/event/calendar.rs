@@ -27,6 +27,9 @@
 //! events at one instant) cannot pile them up. Against a heap of ball indices that
 //! moved each ball's heap position with it: see `docs/event-engine.md`.
 //!
+//! Each pop also reads one ball of the next bucket's list ahead (`read_ahead`), so that
+//! emptying that bucket into the heap finds its links in the cache.
+//!
 //! Ties are broken by ball index, so the order of events is deterministic.
 
 use carom_math::{Real, floor_to_i64};
