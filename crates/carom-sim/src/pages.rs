@@ -200,13 +200,20 @@ mod tests {
     }
 
     #[test]
-    fn large_arrays_start_on_a_huge_page_of_their_own() {
-        let large = Array::filled(LARGE / 8, |i| i as u64);
+    fn large_arrays_take_whole_huge_pages_small_ones_an_ordinary_allocation() {
         let small = Array::filled(LARGE / 8 - 1, |i| i as u64);
+        assert_eq!(small.layout.size(), LARGE - 8);
+        assert_eq!(small.layout.align(), align_of::<u64>());
+        let large = Array::filled(LARGE / 8 + 1, |i| i as u64);
+        let larger = Array::filled(HUGE_PAGE / 8 + 1, |i| i as u64);
         if cfg!(all(target_os = "linux", target_arch = "x86_64")) {
-            assert_eq!(large.as_ptr() as usize % HUGE_PAGE, 0);
+            for (array, pages) in [(&large, 1), (&larger, 2)] {
+                assert_eq!(array.as_ptr() as usize % HUGE_PAGE, 0);
+                assert_eq!(array.layout.size(), pages * HUGE_PAGE);
+            }
+        } else {
+            assert_eq!(large.layout.size(), LARGE + 8);
         }
-        assert_eq!(small.as_ptr() as usize % align_of::<u64>(), 0);
     }
 
     #[test]
