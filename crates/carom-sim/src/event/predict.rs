@@ -206,11 +206,20 @@ where
             reach: T::lit(2.0) * T::EPSILON * ball.center().amax(),
         };
         match (near, &self.partners) {
-            (Near::Entering { axis, upper }, Partners::Cells(cells)) => {
-                cells.for_each_entering(i, axis, upper, |j| self.offer_partner(&probe, j, best));
-            }
-            (_, Partners::Cells(cells)) => {
-                cells.for_each_near(i, |j| self.offer_partner(&probe, j, best));
+            (near, Partners::Cells(cells)) => {
+                let mut batch = Batch::default();
+                let mut collect = |j: usize| {
+                    batch.add(j, &self.balls.motion, |j| {
+                        self.offer_partner(&probe, j, best);
+                    });
+                };
+                match near {
+                    Near::Entering { axis, upper } => {
+                        cells.for_each_entering(i, axis, upper, &mut collect);
+                    }
+                    Near::Around => cells.for_each_near(i, &mut collect),
+                }
+                batch.flush(|j| self.offer_partner(&probe, j, best));
             }
             (_, Partners::Lists(lists)) => {
                 for j in lists.partners(i) {
@@ -327,6 +336,44 @@ struct Probe<'a, T: Real, const D: usize> {
     /// double-double check when its error moves the pair by less (carom-toi's
     /// `relative_contact_time`).
     reach: T,
+}
+
+/// Partners from cell lists, collected before any is tested, each one's record asked for
+/// (`prefetch`) as it is collected, so that the records' cache misses overlap instead of
+/// each test waiting for its own. The order of the tests is the order of collection (a
+/// full batch is tested before the next partner joins), so ties resolve as without it.
+///
+/// Measured on the 2D gas (docs/event-engine.md, eleventh session): at 1e5 balls ×1.025
+/// and ×1.095 in two sets of rounds, at 1e4 ×1.027, for 4 % more instructions. Neighbour
+/// lists do not batch: their 3D gas ran 3 % slower so (a list is one row whose partners
+/// the engine already reads ahead for the next event's ball).
+#[derive(Default)]
+struct Batch {
+    ids: [u32; 16],
+    len: usize,
+}
+
+impl Batch {
+    /// Adds partner `j` (its record `records[j]` asked for), testing the batch first
+    /// with `offer` when it is full.
+    #[inline]
+    fn add<X>(&mut self, j: usize, records: &[X], mut offer: impl FnMut(usize)) {
+        if self.len == self.ids.len() {
+            self.flush(&mut offer);
+        }
+        crate::prefetch::prefetch(&records[j]);
+        self.ids[self.len] = j as u32;
+        self.len += 1;
+    }
+
+    /// Tests the partners collected, in order, and empties the batch.
+    #[inline]
+    fn flush(&mut self, mut offer: impl FnMut(usize)) {
+        for &j in &self.ids[..self.len] {
+            offer(j as usize);
+        }
+        self.len = 0;
+    }
 }
 
 /// The earliest candidate event so far; later searches use its time as their horizon.
