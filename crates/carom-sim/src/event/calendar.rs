@@ -88,7 +88,7 @@ pub struct Calendar<T: Real> {
     /// The number of live entries in the heap.
     heap_live: usize,
     /// The ball whose successor in the next bucket's list is read ahead at the next pop
-    /// (`NONE`: nothing to read ahead; see [`Calendar::pop`]).
+    /// (`NONE`: nothing to read ahead; see `read_ahead`).
     ahead: u32,
     overflow: Vec<u32>,
     /// The inverse of the bucket width.
