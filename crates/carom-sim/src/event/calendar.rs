@@ -302,7 +302,7 @@ impl<T: Real> Calendar<T> {
     ///
     /// Emptying a bucket into the heap follows its list from ball to ball, each step a
     /// read of a random ball's link that waits for the one before (4 % of the 2D gas's
-    /// time at 1e5 balls). A bucket holds about as many events as it takes pops to empty
+    /// profile samples at 1e5 balls, on that read). A bucket holds about as many events as it takes pops to empty
     /// the one before, so one step per pop has the next bucket's list in the cache when
     /// the heap runs dry. The list may change meanwhile (a ball inserted at its head was
     /// just written; one removed has no successor, which ends the walk; one moved to

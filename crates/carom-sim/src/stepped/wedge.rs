@@ -60,7 +60,7 @@ pub(crate) struct Repeats<T> {
     anchor: Vec<T>,
     count: Vec<u32>,
     /// The time of each ball's last contact, and how many it has had in a chain, each
-    /// within the chain's instant of the one before.
+    /// within a link (`note`'s `link`) of the one before.
     last: Vec<T>,
     chain: Vec<u32>,
     /// The balls with a non-zero count (to forget in [`Self::clear`]).
