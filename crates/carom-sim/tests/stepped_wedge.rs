@@ -450,3 +450,41 @@ fn a_ball_pressed_into_a_corner_by_a_moving_box_is_named_crushed_not_let_into_th
         assert!((e.time + 0.756_543).abs() < 1e-5, "{what}: {e}");
     }
 }
+
+/// A fuzzed scene, reduced: a 1 g ball between two 1,000 kg balls, one at 7.4e5 m/s,
+/// 1,000 m from the origin in a periodic box (friction, drag, ball restitution 0, a
+/// static box). The heavy balls close on the light one while sliding past it at 1e5
+/// m/s: the wedge's hold left them approaching at 3e-11 m/s along its normal, and the
+/// time of impact, whose normal rounding turns by about 1e-12 rad, saw 5.6e-8 m/s, a
+/// contact again at the same instant, until the run ended with "balls[1] is crushed"
+/// at 1.06e-4 s (the exact integrator; the full scene with every integrator). A normal
+/// between two centres now counts its rounding, the coordinates' resolution over the
+/// radii, in the approach it tells: the scene runs with every integrator, the balls
+/// apart (minimum images) and the energy never rising.
+const LIGHT_BALL_BETWEEN_FAST_HEAVY_BALLS: &str =
+    include_str!("scenes/light_ball_between_fast_heavy_balls.toml");
+
+#[test]
+fn a_light_ball_between_heavy_balls_sliding_past_it_fast_is_not_taken_for_crushed() {
+    let LoadedScene::D2(s) = parse_scene(LIGHT_BALL_BETWEEN_FAST_HEAVY_BALLS).unwrap() else {
+        panic!("a 2D scene")
+    };
+    let period = s.world.border.as_ref().unwrap().border.extents();
+    for integrator in Integrator::ALL {
+        run_steps(&s, integrator, 50, |what, st, e_before, e| {
+            assert!(
+                e <= e_before * (1.0 + 1e-12),
+                "{what}: energy {e_before} -> {e}"
+            );
+            for (a, b) in [(0, 1), (0, 2), (1, 2)] {
+                let d = (st.pos[b] - st.pos[a]).zip_map(&period, |x, l| x - l * (x / l).round());
+                let gap = d.norm() - s.balls[a].radius - s.balls[b].radius;
+                assert!(
+                    gap >= -1e-9,
+                    "{what}: balls {a} and {b} overlap by {:e}",
+                    -gap
+                );
+            }
+        });
+    }
+}

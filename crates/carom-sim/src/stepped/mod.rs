@@ -1118,13 +1118,7 @@ where
     /// The error for cluster `cluster` spinning at `spin` rad/s, too fast to follow over
     /// the `rest` of a step in what is left of [`MAX_SUBSTEPS`] sub-steps after the
     /// `taken` ones.
-    fn spinning_too_fast(
-        &self,
-        cluster: Option<usize>,
-        spin: T,
-        rest: T,
-        taken: u64,
-    ) -> SimError {
+    fn spinning_too_fast(&self, cluster: Option<usize>, spin: T, rest: T, taken: u64) -> SimError {
         let members = cluster.map_or_else(Vec::new, |k| self.clusters.list[k].members.clone());
         let named: Vec<String> = (members.iter().take(4))
             .map(|m| format!("balls[{m}]"))
