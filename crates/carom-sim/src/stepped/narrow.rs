@@ -76,7 +76,8 @@ pub(crate) struct Event<T: Real, const D: usize> {
 impl<T: Real, const D: usize> Event<T, D> {
     /// The total order the queue pops in: the instant, then bottom-up along gravity, then
     /// the time, the pair and the versions. Contacts within one simultaneity window (a
-    /// millionth of the step) are one instant: a pile of balls touching within rounding
+    /// millionth of the step, or less when balls move fast: `SteppedEngine::instant_width`)
+    /// are one instant: a pile of balls touching within rounding
     /// is settled from the floor up, so that every ball finds its supports already at
     /// rest. Equal keys are the same prediction, so the order never depends on how
     /// events were inserted (thread count, chunking).
