@@ -1034,11 +1034,15 @@ where
     /// ran on past the side wall, which only the wall's answer would have shown it; it
     /// ended 1.2e-5 m beyond it (a fuzzed scene, `--dt 0.01`: the millionth of the step
     /// was 1e-8 s).
+    ///
+    /// At least `ε` of the step, so that a step holds at most `1/ε` instants (`2⁵²` in
+    /// `f64`), each numbered exactly: at absurd speeds every contact is then its own
+    /// instant but for those that close.
     fn instant_width(&self, fastest: T) -> T {
         let width = T::lit(self.clock.dt * SIMULTANEITY);
         let travel = T::lit(SIMULTANEOUS_TRAVEL);
         if fastest * width > travel {
-            travel / fastest
+            (travel / fastest).max(T::lit(self.clock.dt) * T::EPSILON)
         } else {
             width
         }
