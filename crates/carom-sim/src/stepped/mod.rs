@@ -338,7 +338,7 @@ where
             stats: StepStats::default(),
             pipeline: Vec::new(),
             event_budget: 1_000_000_u64.max(256 * n as u64),
-            resting_floor: rules.floor,
+            resting_floor: rules.contact_floor,
             instant: T::lit(dt * SIMULTANEITY),
             periodic_reach,
             escape_bound: 64.max(n / 16),

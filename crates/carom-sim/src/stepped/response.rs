@@ -73,6 +73,12 @@ pub(crate) struct Rules<T: Real, const D: usize> {
     /// what gravity adds in a step plus `64 ε` times the scene's speed scale (the fastest
     /// ball or box at the start).
     pub(crate) floor: T,
+    /// The part of [`Rules::floor`] gravity sets, a millionth of what it adds in a step:
+    /// the floor below which the narrow phase takes a contact for resting, which counts
+    /// the rounding of the contact's own speeds itself (`narrow::Narrow::not_approaching`).
+    /// With the whole floor, a ball resting on the floor next to a 4e4 m/s ball in `f32`
+    /// (where `64 ε` of that speed is 0.3 m/s) fell through it at `g h` = 0.1 m/s per step.
+    pub(crate) contact_floor: T,
     /// `inelastic = "stick"`: two balls whose pair restitution is 0 fuse (see `stick`).
     pub(crate) stick: bool,
 }
@@ -105,6 +111,7 @@ impl<T: Real, const D: usize> Rules<T, D> {
             collapse: CollapseGuard::elastic_below(collapse_speed).map_err(bad_step)?,
             support_speed: T::lit(2.0) * g * h,
             floor: T::lit(1e-6) * g * h + T::lit(64.0) * T::EPSILON * speed,
+            contact_floor: T::lit(1e-6) * g * h,
             stick: world.inelastic == Inelastic::Stick,
         })
     }
