@@ -10,7 +10,8 @@
 //! A contact whose normal approach speed at the time of contact is at the level of
 //! rounding (`64 ε` times the two speeds for a ball or a box, and for two balls also the
 //! relative speed times the angle rounding turns the normal between their centres by;
-//! `64 ε` of the approach itself for a wall, whose normal is an axis) is not an event:
+//! none for a wall, whose normal is an axis and whose approach is a component of the
+//! chord, read exactly) is not an event:
 //! it comes from a pair left touching with zero relative normal velocity by a previous
 //! response, and acting on it would only repeat that response. Contacts approaching
 //! slower than a millionth of what gravity adds in one step are not events either: they
@@ -193,8 +194,8 @@ where
     ///
     /// The rounding counted is `64 ε` of the speeds a response computes the approach
     /// from: both bodies' whole speeds for a ball or a box (the normal is any direction),
-    /// only the approach itself for a wall of the border (its normal is an axis, and the
-    /// approach is a component of the chord, read as it is): a ball bouncing between
+    /// none for a wall of the border (its normal is an axis, and the approach is a
+    /// component of the chord, read exactly): a ball bouncing between
     /// floor and ceiling at 6e4 m/s in `f32` (where `64 ε` of that is 0.46 m/s) was let
     /// through a side wall it approached at 0.04 m/s, and ended 0.95 m outside the box.
     ///
@@ -226,7 +227,7 @@ where
                     + relative.norm() * angle
             }
             Target::Box(_) => T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm()),
-            Target::Border => T::lit(64.0) * T::EPSILON * approach.abs(),
+            Target::Border => T::zero(),
         };
         approach <= rounding || approach <= self.resting_floor
     }
