@@ -194,7 +194,6 @@ where
     stats: StepStats,
     pipeline: Vec<String>,
     event_budget: u64,
-    resting_floor: T,
     /// The current window's simultaneity window (see [`SteppedEngine::instant_width`]).
     instant: T,
     /// The largest distance a ball may move in one window of a periodic domain.
@@ -338,7 +337,6 @@ where
             stats: StepStats::default(),
             pipeline: Vec::new(),
             event_budget: 1_000_000_u64.max(256 * n as u64),
-            resting_floor: rules.contact_floor,
             instant: T::lit(dt * SIMULTANEITY),
             periodic_reach,
             escape_bound: 64.max(n / 16),
@@ -530,7 +528,7 @@ where
             border: self.border.as_ref(),
             periodic: self.periodic.as_ref(),
             end,
-            resting_floor: self.resting_floor,
+            resting_floor: self.rules.contact_floor,
             gravity: self.rules.gravity,
             instant: self.instant,
         }
@@ -555,7 +553,7 @@ where
             border: self.border.as_ref(),
             periodic: self.periodic.as_ref(),
             end: b,
-            resting_floor: self.resting_floor,
+            resting_floor: self.rules.contact_floor,
             gravity: self.rules.gravity,
             instant: self.instant,
         };

@@ -102,6 +102,7 @@ impl<T: Real, const D: usize> Rules<T, D> {
             .chain(scene.boxes.iter().map(|b| b.vel.norm()))
             .fold(g * h, T::max);
         let collapse_speed = (g * h).max(T::lit(1e-6) * speed).max(T::MIN_POSITIVE);
+        let contact_floor = T::lit(1e-6) * g * h;
         let bad_step = |e: carom_math::InvalidValue| SceneError::new("--dt", e.to_string());
         Ok(Self {
             friction: world.friction,
@@ -110,8 +111,8 @@ impl<T: Real, const D: usize> Rules<T, D> {
             resting: RestingGuard::new(T::lit(2.0) * h).map_err(bad_step)?,
             collapse: CollapseGuard::elastic_below(collapse_speed).map_err(bad_step)?,
             support_speed: T::lit(2.0) * g * h,
-            floor: T::lit(1e-6) * g * h + T::lit(64.0) * T::EPSILON * speed,
-            contact_floor: T::lit(1e-6) * g * h,
+            floor: contact_floor + T::lit(64.0) * T::EPSILON * speed,
+            contact_floor,
             stick: world.inelastic == Inelastic::Stick,
         })
     }
