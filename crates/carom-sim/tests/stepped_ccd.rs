@@ -11,11 +11,11 @@ mod common;
 use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;
 use carom_math::{Real, Space};
-use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, LoadedScene, Scene, World, parse_scene};
+use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
 use carom_sim::scenes::classic;
 use carom_sim::scenes::gas::{GasParams, gas};
 use carom_sim::{Collision, Simulation};
-use common::{Recorder, states, stepped};
+use common::{Recorder, each_step, outside_border, scene_2d, states, stepped};
 use nalgebra::{Const, Vector2, Vector3};
 
 const DT: f64 = 1.0 / 600.0;
@@ -391,26 +391,14 @@ const LIGHT_BALL_PUMPED_INTO_A_CORNER: &str =
 
 #[test]
 fn a_light_ball_pumped_into_a_corner_stays_inside_the_box() {
-    let LoadedScene::D2(s) = parse_scene(LIGHT_BALL_PUMPED_INTO_A_CORNER).unwrap() else {
-        panic!("a 2D scene")
-    };
-    let border = s.world.border.as_ref().unwrap().border;
-    for integrator in Integrator::ALL {
-        let mut sim = stepped(&s, integrator, 0.01);
-        for k in 1..=75 {
-            sim.advance_to(f64::from(k) * 0.01, &mut ()).unwrap();
-            for (i, (b, x)) in s.balls.iter().zip(&states(&sim).pos).enumerate() {
-                for a in 0..2 {
-                    let outside = (border.min()[a] - (x[a] - b.radius))
-                        .max(x[a] + b.radius - border.max()[a]);
-                    assert!(
-                        outside <= 1e-9,
-                        "{integrator}, step {k}: ball {i} {outside:e} m outside"
-                    );
-                }
-            }
-        }
-    }
+    let s = scene_2d(LIGHT_BALL_PUMPED_INTO_A_CORNER);
+    each_step(&s, 0.01, 75, |integrator, k, sim| {
+        let outside = outside_border(&s, &states(sim));
+        assert!(
+            outside <= 1e-9,
+            "{integrator}, step {k}: {outside:e} m outside"
+        );
+    });
 }
 
 /// In `f32` (`64 ε` = 7.6e-6): a ball bouncing between floor and ceiling at 6e4 m/s
@@ -443,18 +431,14 @@ fn a_fast_ball_in_f32_does_not_pass_a_side_wall_it_drifts_into() {
     }
     .cast::<f32>()
     .unwrap();
-    for integrator in Integrator::ALL {
-        let mut sim = stepped(&s, integrator, 0.01);
-        for k in 1..=100 {
-            sim.advance_to(0.01 * k as f32, &mut ()).unwrap();
-            let x = states(&sim).pos[0].x;
-            assert!(
-                x - 0.014 >= -1.87 - 1e-6,
-                "{integrator}, step {k}: {:e} m outside",
-                -1.87 - (x - 0.014)
-            );
-        }
-    }
+    each_step(&s, 0.01, 100, |integrator, k, sim| {
+        let x = states(sim).pos[0].x;
+        assert!(
+            x - r as f32 >= -1.87 - 1e-6,
+            "{integrator}, step {k}: {:e} m outside",
+            -1.87 - (x - r as f32)
+        );
+    });
 }
 
 /// In `f32`: a ball resting on the floor of a 3D box while another ball flies at 4.2e4
@@ -499,16 +483,12 @@ fn a_ball_resting_on_the_floor_beside_a_very_fast_ball_in_f32_stays_on_it() {
     }
     .cast::<f32>()
     .unwrap();
-    for integrator in Integrator::ALL {
-        let mut sim = stepped(&s, integrator, 0.01);
-        for k in 1..=50 {
-            sim.advance_to(0.01 * k as f32, &mut ()).unwrap();
-            let y = states(&sim).pos[1].y;
-            assert!(
-                y - r as f32 >= floor as f32 - 1e-6,
-                "{integrator}, step {k}: {:e} m below the floor",
-                floor as f32 - (y - r as f32)
-            );
-        }
-    }
+    each_step(&s, 0.01, 50, |integrator, k, sim| {
+        let y = states(sim).pos[1].y;
+        assert!(
+            y - r as f32 >= floor as f32 - 1e-6,
+            "{integrator}, step {k}: {:e} m below the floor",
+            floor as f32 - (y - r as f32)
+        );
+    });
 }

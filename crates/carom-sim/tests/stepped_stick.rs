@@ -11,15 +11,13 @@ use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;
 use carom_math::{Space, Vector};
 use carom_sim::plan::{RunOptions, plan};
-use carom_sim::scene::{
-    BallSpec, BorderSpec, BoxSpec, Inelastic, LoadedScene, Scene, World, parse_scene,
-};
+use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Inelastic, Scene, World};
 use carom_sim::scenes::collision_lab::{InelasticPreset, Options, Screen, scene};
 use carom_sim::scenes::gas::{GasParams, gas};
 use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Collision, EngineKind, EventEngine, Simulation, observe};
 use carom_toi::Direction;
-use common::{Recorder, states, stepped};
+use common::{Recorder, each_step, outside_border, scene_2d, states, stepped};
 use nalgebra::{Const, Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector2, Vector3};
 
 type Angular<const D: usize> = <Const<D> as Space<f64, D>>::Angular;
@@ -973,7 +971,6 @@ fn run_in_box(
     rec: &mut Recorder<f64>,
 ) -> (SteppedEngine<f64, 3>, f64) {
     let mut sim = stepped(s, integrator, dt);
-    let border = s.world.border.as_ref().unwrap().border;
     let mut outside = 0.0_f64;
     let mut e_before = observe::energy(s, &states(&sim));
     for k in 1..=steps {
@@ -985,13 +982,7 @@ fn run_in_box(
             "{integrator}, step {k}: energy {e_before} -> {e}"
         );
         e_before = e;
-        for (b, x) in s.balls.iter().zip(&st.pos) {
-            for a in 0..3 {
-                outside = outside
-                    .max(border.min()[a] - (x[a] - b.radius))
-                    .max(x[a] + b.radius - border.max()[a]);
-            }
-        }
+        outside = outside.max(outside_border(s, &st));
     }
     (sim, outside)
 }
@@ -1131,28 +1122,18 @@ fn a_spinning_cluster_held_in_a_corner_from_the_start_of_each_sub_step_runs_on()
         radius = 0.059567934567242714
         mass = 2.1036320154494876
     "#;
-    let LoadedScene::D2(s) = parse_scene(SCENE).unwrap() else {
-        panic!("a 2D scene")
-    };
-    let border = s.world.border.as_ref().unwrap().border;
-    for integrator in Integrator::ALL {
-        let mut sim = stepped(&s, integrator, 0.01);
-        let mut outside = 0.0_f64;
-        for k in 1..=200 {
-            sim.advance_to(f64::from(k) * 0.01, &mut ())
-                .unwrap_or_else(|e| panic!("{integrator}, step {k}: {e}"));
-            for (b, x) in s.balls.iter().zip(&states(&sim).pos) {
-                for a in 0..2 {
-                    outside = outside
-                        .max(border.min()[a] - (x[a] - b.radius))
-                        .max(x[a] + b.radius - border.max()[a]);
-                }
-            }
-        }
-        assert_eq!(sim.counters().ball_ball, 1, "{integrator}: one fusion");
+    let s = scene_2d(SCENE);
+    each_step(&s, 0.01, 200, |integrator, k, sim| {
         // The coordinates' resolution here: 50,000 m in f64 is 7e-12 m.
-        assert!(outside <= 1e-9, "{integrator}: {outside} m outside");
-    }
+        let outside = outside_border(&s, &states(sim));
+        assert!(
+            outside <= 1e-9,
+            "{integrator}, step {k}: {outside} m outside"
+        );
+        if k == 200 {
+            assert_eq!(sim.counters().ball_ball, 1, "{integrator}: one fusion");
+        }
+    });
 }
 
 /// The number that follows the first `key` in `message`, up to the next space.

@@ -19,11 +19,11 @@ use carom_math::{Space, Vector};
 use carom_sim::observe::energy;
 use carom_sim::plan::BroadChoice;
 use carom_sim::plan::{RunOptions, plan};
-use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, LoadedScene, Scene, World, parse_scene};
+use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
 use carom_sim::stepped::StepStats;
 use carom_sim::{BallStates, EngineKind, EventEngine, Simulation};
 use carom_toi::Direction;
-use common::{states, stepped, stepped_with};
+use common::{scene_2d, states, stepped, stepped_with};
 use nalgebra::{Const, Vector2, Vector3};
 
 const DT: f64 = 0.01;
@@ -336,9 +336,7 @@ min = [-2.0, -2.0]
 max = [2.0, 2.0]
 restitution = 1.0
 ";
-    let LoadedScene::D2(s) = parse_scene(text).unwrap() else {
-        panic!("a 2D scene");
-    };
+    let s = scene_2d(text);
     for integrator in Integrator::ALL {
         let stats = run_steps(&s, integrator, 100, |what, st, e_before, e| {
             assert!(
@@ -415,9 +413,7 @@ const CORNER_CRUSH: &str = include_str!("scenes/corner_crush.toml");
 
 #[test]
 fn a_ball_pressed_into_a_corner_by_a_moving_box_is_named_crushed_not_let_into_the_box() {
-    let LoadedScene::D2(s) = parse_scene(CORNER_CRUSH).unwrap() else {
-        panic!("a 2D scene")
-    };
+    let s = scene_2d(CORNER_CRUSH);
     let moving = &s.boxes[1];
     for (integrator, dt, sample) in [
         (Integrator::SemiImplicitEuler, 1.0 / 600.0, 0.1),
@@ -466,9 +462,7 @@ const LIGHT_BALL_BETWEEN_FAST_HEAVY_BALLS: &str =
 
 #[test]
 fn a_light_ball_between_heavy_balls_sliding_past_it_fast_is_not_taken_for_crushed() {
-    let LoadedScene::D2(s) = parse_scene(LIGHT_BALL_BETWEEN_FAST_HEAVY_BALLS).unwrap() else {
-        panic!("a 2D scene")
-    };
+    let s = scene_2d(LIGHT_BALL_BETWEEN_FAST_HEAVY_BALLS);
     let period = s.world.border.as_ref().unwrap().border.extents();
     for integrator in Integrator::ALL {
         run_steps(&s, integrator, 50, |what, st, e_before, e| {

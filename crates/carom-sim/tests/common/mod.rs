@@ -1,6 +1,8 @@
 //! Helpers shared by the stepped-engine and hand-over tests: building an engine from a
-//! scene with given options, collecting collisions, keeping what `carom run`'s driver
-//! hands its sink, reading states, checking that a resting scene stays put.
+//! scene with given options, reading a 2D scene file, running a scene step by step with
+//! every integrator, collecting collisions, keeping what `carom run`'s driver hands its
+//! sink, reading states, measuring how far balls stray out of the border, checking that
+//! a resting scene stays put.
 
 #![allow(dead_code)] // each test file uses a part
 
@@ -8,7 +10,7 @@ use carom_integrate::Integrator;
 use carom_math::{Real, Space, Vector};
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};
 use carom_sim::run::RunSink;
-use carom_sim::scene::Scene;
+use carom_sim::scene::{LoadedScene, Scene, parse_scene};
 use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Collision, Observer, Simulation, observe};
 use carom_toi::Direction;
@@ -45,6 +47,56 @@ where
     };
     let p = plan(scene, &options).expect("a valid plan");
     SteppedEngine::new(scene, &p, direction).expect("a valid scene")
+}
+
+/// The 2D scene of the scene-file text `text`.
+pub(crate) fn scene_2d(text: &str) -> Scene<f64, 2> {
+    match parse_scene(text).expect("a valid scene") {
+        LoadedScene::D2(s) => s,
+        LoadedScene::D3(_) => panic!("a 2D scene"),
+    }
+}
+
+/// Runs `scene` with every integrator for `steps` steps of `dt`, calling `check` after
+/// each with the integrator, the step's number (from 1) and the engine. A step that
+/// fails panics, naming both.
+pub(crate) fn each_step<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    dt: f64,
+    steps: u32,
+    mut check: impl FnMut(Integrator, u32, &SteppedEngine<T, D>),
+) where
+    Const<D>: Space<T, D>,
+{
+    for integrator in Integrator::ALL {
+        let mut sim = stepped(scene, integrator, dt);
+        for k in 1..=steps {
+            sim.advance_to(T::lit(dt * f64::from(k)), &mut ())
+                .unwrap_or_else(|e| panic!("{integrator}, step {k}: {e}"));
+            check(integrator, k, &sim);
+        }
+    }
+}
+
+/// How far (m) the farthest ball's surface lies beyond the scene's border (negative
+/// when every ball is inside).
+pub(crate) fn outside_border<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    states: &BallStates<T, D>,
+) -> f64
+where
+    Const<D>: Space<T, D>,
+{
+    let border = scene.world.border.as_ref().expect("a border").border;
+    let mut outside = f64::NEG_INFINITY;
+    for (ball, x) in scene.balls.iter().zip(&states.pos) {
+        for a in 0..D {
+            let below = border.min()[a] - (x[a] - ball.radius);
+            let above = x[a] + ball.radius - border.max()[a];
+            outside = outside.max(below.max(above).to_f64());
+        }
+    }
+    outside
 }
 
 /// The state of every ball now.
