@@ -76,8 +76,9 @@ pub(crate) struct Rules<T: Real, const D: usize> {
     /// The part of [`Rules::floor`] gravity sets, a millionth of what it adds in a step:
     /// the floor below which the narrow phase takes a contact for resting, which counts
     /// the rounding of the contact's own speeds itself (`narrow::Narrow::not_approaching`).
-    /// With the whole floor, a ball resting on the floor next to a 4e4 m/s ball in `f32`
-    /// (where `64 ε` of that speed is 0.3 m/s) fell through it at `g h` = 0.1 m/s per step.
+    /// With the whole floor, a ball resting on the floor next to a 4.2e4 m/s ball in `f32`
+    /// (where `64 ε` of that speed is 0.32 m/s) approached it at `g h` = 0.098 m/s, which
+    /// was no contact, and fell through it (7.2e-2 m in 0.5 s).
     pub(crate) contact_floor: T,
     /// `inelastic = "stick"`: two balls whose pair restitution is 0 fuse (see `stick`).
     pub(crate) stick: bool,
