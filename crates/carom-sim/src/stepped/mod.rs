@@ -196,6 +196,8 @@ where
     event_budget: u64,
     /// The current window's simultaneity window (see [`SteppedEngine::instant_width`]).
     instant: T,
+    /// The current step's length (the end of every segment in it).
+    step_length: T,
     /// The largest distance a ball may move in one window of a periodic domain.
     periodic_reach: T,
     escape_bound: usize,
@@ -338,6 +340,7 @@ where
             pipeline: Vec::new(),
             event_budget: 1_000_000_u64.max(256 * n as u64),
             instant: T::lit(dt * SIMULTANEITY),
+            step_length: T::lit(dt),
             periodic_reach,
             escape_bound: 64.max(n / 16),
         };
@@ -528,7 +531,7 @@ where
             border: self.border.as_ref(),
             periodic: self.periodic.as_ref(),
             end,
-            resting_floor: self.rules.contact_floor,
+            allowance: self.rules.allowance(self.step_length),
             gravity: self.rules.gravity,
             instant: self.instant,
         }
@@ -553,7 +556,7 @@ where
             border: self.border.as_ref(),
             periodic: self.periodic.as_ref(),
             end: b,
-            resting_floor: self.rules.contact_floor,
+            allowance: self.rules.allowance(self.step_length),
             gravity: self.rules.gravity,
             instant: self.instant,
         };
@@ -1197,6 +1200,7 @@ where
     fn step(&mut self, h: T, observer: &mut dyn Observer<T>) -> Result<T, SimError> {
         let t0 = self.clock.s;
         let parallel = self.parallel();
+        self.step_length = h;
         self.integrate(h, t0, parallel);
         let mut a = T::zero();
         let mut step_contacts = 0;

@@ -8,10 +8,11 @@
 //! is made at, within the horizon `end − s`; the event records the in-step time.
 //!
 //! A contact whose normal approach speed at the time of contact is at the level of
-//! rounding (`64 ε` times the two speeds for a ball or a box, and for two balls also the
-//! relative speed times the angle rounding turns the normal between their centres by;
-//! none for a wall, whose normal is an axis and whose approach is a component of the
-//! chord, read exactly) is not an event:
+//! rounding ([`Allowance`]: `64 ε` times the two speeds for a ball or a box, and for two
+//! balls also the relative speed times the angle rounding turns the normal between their
+//! centres by; none for a wall, whose normal is an axis and whose approach is a component
+//! of the chord, read exactly; and the rounding of a cluster member's chord) is not an
+//! event:
 //! it comes from a pair left touching with zero relative normal velocity by a previous
 //! response, and acting on it would only repeat that response. Contacts approaching
 //! slower than a millionth of what gravity adds in one step are not events either: they
@@ -151,6 +152,90 @@ pub(crate) struct Overflow {
     pub(crate) ball: u32,
 }
 
+/// How fast a contact may approach and still be no contact worth acting on: the
+/// rounding of the approach speed, or the resting floor. The narrow phase takes no
+/// slower contact for an event, and a hold (`stack`) stops every contact it holds to a
+/// quarter of this, so that what a hold leaves is never found again as a contact at the
+/// same instant.
+///
+/// The rounding counted is `64 ε` of the speeds a response computes the approach
+/// from: both bodies' whole speeds for a ball or a box (the normal is any direction),
+/// none for a wall of the border (its normal is an axis, and the approach is a
+/// component of the chord, read exactly): a ball bouncing between floor and ceiling at
+/// 6e4 m/s in `f32` (where `64 ε` of that is 0.46 m/s) was let through a side wall it
+/// approached at 0.04 m/s, and ended 0.95 m outside the box.
+///
+/// For two balls, rounding also turns the normal: taken between two centres known to
+/// the coordinates' resolution `ρ`, a distance `d` apart (the sum of the radii at a
+/// contact), its direction is known to about `ρ / d`, and the relative velocity's part
+/// across it, `w`, shows in the approach by up to `|w| ρ / d`. Without that term a pair
+/// sliding past each other fast far from the origin (two 1,000 kg balls at 1e5 m/s
+/// squeezing a 1 g ball 1,000 m out) was left by the wedge's hold approaching at 3e-11
+/// m/s along the hold's normal and found approaching at 5.6e-8 m/s along the time of
+/// impact's, a contact again at the same instant, until the run ended with a false
+/// crush error.
+///
+/// A member of a stuck cluster has a chord computed from its rigid places at the
+/// segment's two ends, `(x₁ − x₀)/τ`, each known to `ρ`: its chord is known to `2ρ/τ`,
+/// which counts for it against a wall too. A cluster held against the floor in a scene
+/// without gravity (no resting floor) was left closing on it at 4.4e-12 m/s, 145 units
+/// of its coordinates' last place over the rest of the step, and found again 16,384
+/// times: a false crush error.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Allowance<T> {
+    /// Contacts approaching slower than this are not events: the part of the floor
+    /// gravity sets (`Rules::contact_floor`).
+    pub(crate) resting_floor: T,
+    /// The step's length, where every segment ends.
+    pub(crate) step: T,
+}
+
+impl<T: Real> Allowance<T> {
+    /// The allowance of ball `ball` moving at `u` against `target` moving at
+    /// `other_velocity`.
+    pub(crate) fn of<const D: usize>(
+        &self,
+        balls: &BallArrays<T, D>,
+        ball: usize,
+        target: Target,
+        u: &Vector<T, D>,
+        other_velocity: &Vector<T, D>,
+    ) -> T
+    where
+        Const<D>: Space<T, D>,
+    {
+        let speeds = T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm());
+        let rounding = match target {
+            Target::Ball(j) => {
+                let j = j as usize;
+                let angle = coordinate_resolution(balls.seg_x[ball].amax())
+                    / (balls.radius[ball] + balls.radius[j]);
+                speeds
+                    + (u - other_velocity).norm() * angle
+                    + self.member_chord(balls, ball)
+                    + self.member_chord(balls, j)
+            }
+            Target::Box(_) => speeds + self.member_chord(balls, ball),
+            Target::Border => self.member_chord(balls, ball),
+        };
+        rounding.max(self.resting_floor)
+    }
+
+    /// How well ball `k`'s chord is known if it is a member of a stuck cluster: `2ρ/τ`
+    /// (see the type's documentation); zero for a free ball.
+    fn member_chord<const D: usize>(&self, balls: &BallArrays<T, D>, k: usize) -> T
+    where
+        Const<D>: Space<T, D>,
+    {
+        let span = self.step - balls.seg_t[k];
+        if balls.cluster[k] == FREE || span <= T::zero() {
+            return T::zero();
+        }
+        let magnitude = balls.seg_x[k].amax().max(balls.pos[k].amax());
+        T::lit(2.0) * coordinate_resolution(magnitude) / span
+    }
+}
+
 /// What predictions read: the balls, the obstacles, the window end and the thresholds.
 pub(crate) struct Narrow<'a, T: Real, const D: usize>
 where
@@ -164,8 +249,8 @@ where
     pub(crate) periodic: Option<&'a Border<T, D>>,
     /// The end of the current window (in-step time).
     pub(crate) end: T,
-    /// Contacts approaching slower than this are not events.
-    pub(crate) resting_floor: T,
+    /// How fast a contact may approach and be no event.
+    pub(crate) allowance: Allowance<T>,
     /// Gravity (for the bottom-up order of simultaneous contacts).
     pub(crate) gravity: Vector<T, D>,
     /// The simultaneity window (in-step time).
@@ -189,25 +274,8 @@ where
     }
 
     /// Whether a ball moving at `u` does not approach `target`, moving at
-    /// `other_velocity`, along `normal` (into it) by more than rounding or the resting
-    /// floor: no contact worth acting on.
-    ///
-    /// The rounding counted is `64 ε` of the speeds a response computes the approach
-    /// from: both bodies' whole speeds for a ball or a box (the normal is any direction),
-    /// none for a wall of the border (its normal is an axis, and the approach is a
-    /// component of the chord, read exactly): a ball bouncing between
-    /// floor and ceiling at 6e4 m/s in `f32` (where `64 ε` of that is 0.46 m/s) was let
-    /// through a side wall it approached at 0.04 m/s, and ended 0.95 m outside the box.
-    ///
-    /// For two balls, rounding also turns the normal: taken between two centres known
-    /// to the coordinates' resolution `ρ`, a distance `d` apart (the sum of the radii at
-    /// a contact), its direction is known to about `ρ / d`, and the relative velocity's
-    /// part across it, `w`, shows in the approach by up to `|w| ρ / d`. Without that
-    /// term a pair sliding past each other fast far from the origin (two 1,000 kg balls
-    /// at 1e5 m/s squeezing a 1 g ball 1,000 m out) was left by the wedge's hold
-    /// approaching at 3e-11 m/s along the hold's normal and found approaching at 5.6e-8
-    /// m/s along the time of impact's, a contact again at the same instant, until the
-    /// run ended with a false crush error.
+    /// `other_velocity`, along `normal` (into it) by more than [`Allowance::of`]: no
+    /// contact worth acting on.
     fn not_approaching(
         &self,
         ball: usize,
@@ -216,20 +284,8 @@ where
         other_velocity: &Vector<T, D>,
         normal: &Vector<T, D>,
     ) -> bool {
-        let relative = u - other_velocity;
-        let approach = relative.dot(normal);
-        let rounding = match target {
-            Target::Ball(j) => {
-                let b = self.balls;
-                let angle = coordinate_resolution(b.seg_x[ball].amax())
-                    / (b.radius[ball] + b.radius[j as usize]);
-                T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm())
-                    + relative.norm() * angle
-            }
-            Target::Box(_) => T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm()),
-            Target::Border => T::zero(),
-        };
-        approach <= rounding || approach <= self.resting_floor
+        let approach = (u - other_velocity).dot(normal);
+        approach <= (self.allowance).of(self.balls, ball, target, u, other_velocity)
     }
 
     /// Turns a time of impact into an event, or `None` if it is no contact worth acting on.

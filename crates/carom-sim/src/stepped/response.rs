@@ -46,6 +46,7 @@ use nalgebra::Const;
 use super::balls::BallArrays;
 use super::clusters::{Clusters, Flight};
 use super::lcp::Lcp;
+use super::narrow::Allowance;
 use super::obstacles::BoxArrays;
 use super::rest::{RestSet, Support, Touch};
 use super::stack::Groups;
@@ -75,7 +76,7 @@ pub(crate) struct Rules<T: Real, const D: usize> {
     pub(crate) floor: T,
     /// The part of [`Rules::floor`] gravity sets, a millionth of what it adds in a step:
     /// the floor below which the narrow phase takes a contact for resting, which counts
-    /// the rounding of the contact's own speeds itself (`narrow::Narrow::not_approaching`).
+    /// the rounding of the contact's own speeds itself ([`Rules::allowance`]).
     /// With the whole floor, a ball resting on the floor next to a 4.2e4 m/s ball in `f32`
     /// (where `64 ε` of that speed is 0.32 m/s) approached it at `g h` = 0.098 m/s, which
     /// was no contact, and fell through it (7.2e-2 m in 0.5 s).
@@ -116,6 +117,15 @@ impl<T: Real, const D: usize> Rules<T, D> {
             contact_floor,
             stick: world.inelastic == Inelastic::Stick,
         })
+    }
+
+    /// How fast a contact may approach in a step of length `h` and be no contact: the
+    /// narrow phase's events and the holds' aim (see [`Allowance`]).
+    pub(crate) fn allowance(&self, h: T) -> Allowance<T> {
+        Allowance {
+            resting_floor: self.contact_floor,
+            step: h,
+        }
     }
 
     /// Whether ball `lower` (centre and radius) lies below ball `upper` along gravity, so

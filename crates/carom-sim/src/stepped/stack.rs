@@ -66,6 +66,7 @@ use nalgebra::Const;
 use carom_response::RigidCluster;
 
 use super::clusters::{FREE, Motion};
+use super::narrow::Target;
 use super::response::{Contacts, Effect, touch_tolerance};
 use super::stick::Side;
 use super::sweep::path_box;
@@ -135,11 +136,12 @@ enum Other<T: Real, const D: usize> {
 }
 
 /// A contact of the stack: `end` touches `other` along the unit `normal` (from the ball
-/// into the other) across `gap`.
+/// into the other) across `gap`; `target` is what the narrow phase calls the other.
 #[derive(Clone, Copy, Debug)]
 struct Row<T: Real, const D: usize> {
     end: End<T, D>,
     other: Other<T, D>,
+    target: Target,
     normal: Vector<T, D>,
     gap: T,
 }
@@ -481,14 +483,8 @@ where
     fn hold(&mut self, stack: &mut Stack<T, D>, held: &[usize], s: T, pushed: &mut [bool]) {
         let rest = self.h - s;
         let targets: Vec<T> = held.iter().map(|&c| stack.rows[c].gap / rest).collect();
-        // What the rounds leave closing beyond their target counts as closing.
-        let done = self.rules.floor * T::lit(0.25);
-        self.hold_rounds(stack, held, &targets, done, pushed);
-        let excess = self.excess(stack, held, &targets);
-        let closing: Vec<usize> = (held.iter().zip(&excess))
-            .filter(|&(_, &u)| u > done)
-            .map(|(&c, _)| c)
-            .collect();
+        self.hold_rounds(stack, held, &targets, pushed);
+        let closing: Vec<usize> = self.closing(stack, held, &targets).collect();
         if closing.is_empty() {
             return;
         }
@@ -514,7 +510,7 @@ where
         }
         self.strike(stack, &stop);
         self.save_free(stack);
-        self.hold_rounds(stack, held, &targets, done, pushed);
+        self.hold_rounds(stack, held, &targets, pushed);
     }
 
     /// How much faster than its target (the speed that closes its gap over the rest of
@@ -529,28 +525,65 @@ where
             .collect()
     }
 
+    /// How much faster than its target row `c` may still close when the hold is done: a
+    /// quarter of what the narrow phase allows its contact ([`Rules::allowance`]), so that
+    /// no contact a hold leaves is found again at the same instant. Where that allows
+    /// nothing or more than the floor, a quarter of the floor, as for every row before: a
+    /// free ball against a wall without gravity is allowed no approach at all, which no
+    /// hold's rounding can promise.
+    ///
+    /// [`Rules::allowance`]: super::response::Rules::allowance
+    fn done(&self, stack: &Stack<T, D>, c: usize) -> T {
+        let row = &stack.rows[c];
+        let b = &*self.balls;
+        let other = match row.other {
+            Other::Surface(v) => v,
+            Other::Held(j) => b.chord[j],
+            Other::Part(e) => b.chord[e.ball],
+        };
+        let ball = row.end.ball;
+        let allowed =
+            (self.rules.allowance(self.h)).of(b, ball, row.target, &b.chord[ball], &other);
+        let floor = self.rules.floor;
+        let allowed = if allowed > T::zero() {
+            allowed.min(floor)
+        } else {
+            floor
+        };
+        allowed * T::lit(0.25)
+    }
+
+    /// The rows of `held` closing faster than their targets by more than [`Self::done`].
+    fn closing<'a>(
+        &'a self,
+        stack: &'a Stack<T, D>,
+        held: &'a [usize],
+        targets: &[T],
+    ) -> impl Iterator<Item = usize> + 'a {
+        let excess = self.excess(stack, held, targets);
+        (held.iter().zip(excess))
+            .filter(move |&(&c, u)| u > self.done(stack, c))
+            .map(|(&c, _)| c)
+    }
+
     /// The rounds of [`Self::hold`] towards `targets` until no row exceeds its target by
-    /// more than `done`, then [`Self::central`].
+    /// more than [`Self::done`], then [`Self::central`].
     fn hold_rounds(
         &mut self,
         stack: &Stack<T, D>,
         held: &[usize],
         targets: &[T],
-        done: T,
         pushed: &mut [bool],
     ) {
         let mut total = vec![Vector::<T, D>::zeros(); held.len()];
         let mut unused = vec![false; stack.rows.len()];
         for _ in 0..HOLD_ROUNDS {
+            if self.closing(stack, held, targets).next().is_none() {
+                break;
+            }
             let mut chords: Vec<_> = (0..stack.rows.len())
                 .map(|c| self.relative(stack, c, Phase::Chord))
                 .collect();
-            let left = (held.iter().zip(targets))
-                .map(|(&c, &t)| chords[c].dot(&stack.rows[c].normal) - t)
-                .fold(T::zero(), T::max);
-            if left <= done {
-                break;
-            }
             let force = Self::changes(stack, held, &total, &mut unused);
             for &c in held {
                 let moved = (stack.ends(c)).fold(Vector::zeros(), |sum, (e, sign)| {
@@ -563,13 +596,13 @@ where
             self.push(stack, &changes);
         }
         let mut changes = Self::changes(stack, held, &total, pushed);
-        if self.central(stack, held, targets, done, &mut changes, pushed) {
+        if self.central(stack, held, targets, &mut changes, pushed) {
             self.push(stack, &changes);
         }
     }
 
     /// The hold's last resort, when its rounds leave a row of `held` closing faster than
-    /// its target by more than `done`: pushes through the centres of mass, added to
+    /// its target by more than [`Self::done`]: pushes through the centres of mass, added to
     /// `changes`; returns whether it pushed.
     ///
     /// The rounds converge while the rotation the force adds over the rest of the step
@@ -588,14 +621,13 @@ where
         stack: &Stack<T, D>,
         held: &[usize],
         targets: &[T],
-        done: T,
         changes: &mut Changes<T, D>,
         pushed: &mut [bool],
     ) -> bool {
-        let excess = self.excess(stack, held, targets);
-        if excess.iter().all(|&u| u <= done) {
+        if self.closing(stack, held, targets).next().is_none() {
             return false;
         }
+        let excess = self.excess(stack, held, targets);
         let a = stack.delassus(held, Push::ThroughCentres);
         let q: Vec<T> = excess.iter().map(|&u| -u).collect();
         let mut lambda = vec![T::zero(); held.len()];
@@ -724,14 +756,14 @@ where
         }
     }
 
-    /// Calls `f` with every wall and box ball `x` could touch at `s`: `(unit normal from
-    /// the ball into the surface, surface velocity, gap)` for every wall of the border
-    /// and the nearest point of every box (at its periodic image nearest the ball).
+    /// Calls `f` with every wall and box ball `x` could touch at `s`: `(the surface,
+    /// unit normal from the ball into it, its velocity, gap)` for every wall of the
+    /// border and the nearest point of every box (at its periodic image nearest the ball).
     pub(super) fn for_each_surface(
         &self,
         x: usize,
         s: T,
-        mut f: impl FnMut(Vector<T, D>, Vector<T, D>, T),
+        mut f: impl FnMut(Target, Vector<T, D>, Vector<T, D>, T),
     ) {
         let b = &*self.balls;
         let (p, r) = (b.position_at(x, s), b.radius[x]);
@@ -741,13 +773,13 @@ where
                 for (sign, gap) in [(-T::one(), below), (T::one(), above)] {
                     let mut n = Vector::zeros();
                     n[axis] = sign;
-                    f(n, Vector::zeros(), gap);
+                    f(Target::Border, n, Vector::zeros(), gap);
                 }
             }
         }
         for k in 0..self.boxes.len() {
             if let Some((n, d)) = self.boxes.nearest(k, s, &p, self.periodic) {
-                f(n, self.boxes.vel[k], d - r);
+                f(Target::Box(k as u32), n, self.boxes.vel[k], d - r);
             }
         }
     }
@@ -771,11 +803,12 @@ where
             arm: p + n * r - centre,
             lever: n * r,
         };
-        self.for_each_surface(x, s, |n, v, gap| {
+        self.for_each_surface(x, s, |target, n, v, gap| {
             if near(gap, (chord - v).dot(&n)) {
                 stack.rows.push(Row {
                     end: end(&n),
                     other: Other::Surface(v),
+                    target,
                     normal: n,
                     gap: gap.max(T::zero()),
                 });
@@ -815,6 +848,7 @@ where
                     stack.rows.push(Row {
                         end: end(&n),
                         other: Other::Held(j),
+                        target: Target::Ball(j as u32),
                         normal: n,
                         gap: gap.max(T::zero()),
                     });
@@ -835,6 +869,7 @@ where
             let shift = y - self.balls.position_at(j, s);
             stack.rows.push(Row {
                 end: end(&n),
+                target: Target::Ball(j as u32),
                 other: Other::Part(End {
                     part: other,
                     ball: j,
@@ -1064,21 +1099,21 @@ where
 
     /// Applies `changes` as the constant force of the rest of the step (see the module
     /// documentation), to the state before the hold: chords by `P/m`, end velocities by
-    /// `P/(w m)`, the velocities at the segment start unchanged; spins as impulses. With
-    /// explicit Euler (`w = 0`) no force within the step moves a chord: impulses at the
-    /// segment start.
+    /// `P/(w m)` (`Integrator::end_per_chord` times `P/m` under drag), the velocities at
+    /// the segment start unchanged; spins as impulses. With explicit Euler (`w = 0`) no
+    /// force within the step moves a chord: impulses at the segment start.
     fn push(&mut self, stack: &Stack<T, D>, changes: &Changes<T, D>) {
         let w = T::lit(self.stepper.integrator().chord_weight());
         let flight = self.flight();
-        let (start_share, end_share) = if w > T::zero() {
-            (T::zero(), T::one() / w)
-        } else {
-            (T::one(), T::one())
-        };
         for (part, (linear, angular)) in stack.parts.iter().zip(&changes.impulse) {
             let dv = linear * part.inverse_mass;
             match (part.side, part.free) {
                 (Side::Ball(i), Free::Ball([seg_v, chord, vel], [seg_w, spin])) => {
+                    let (start_share, end_share) =
+                        match flight.end_per_chord(part.inverse_mass, self.balls.seg_t[i]) {
+                            Some(end_share) => (T::zero(), end_share),
+                            None => (T::one(), T::one()),
+                        };
                     let dw =
                         <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
                     self.balls.set_segment(

@@ -275,7 +275,7 @@ where
         for &m in &self.clusters.list[c].members {
             let m = m as usize;
             let tolerance = T::lit(1e-9) * b.radius[m];
-            self.for_each_surface(m, s, |normal, v, gap| {
+            self.for_each_surface(m, s, |_, normal, v, gap| {
                 if gap > tolerance || v != surface_velocity || (normal - n).norm() > T::lit(1e-9) {
                     return;
                 }
