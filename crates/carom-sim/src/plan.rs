@@ -252,9 +252,11 @@ pub fn stepped_broad_phase<T: Real, const D: usize>(
 
 /// Why `integrator` with step `dt` cannot integrate the scene's drag, if it cannot: on
 /// the lightest ball, drag decays at `k = drag/mass`, and beyond the scheme's
-/// [`Integrator::decay_stability_limit`] in `k dt` each step speeds the ball up instead
-/// (a milligram ball under `drag = 0.2` at the default step: `k dt = 333`, its speed
-/// times 332 per step with semi-implicit Euler).
+/// [`Integrator::drag_step_limit`] in `k dt` a step turns the ball back or speeds it up
+/// instead (a milligram ball under `drag = 0.2` at the default step: `k dt = 333`, its
+/// speed times −332 per step with semi-implicit Euler; at `k dt = 1.88` the same scheme
+/// turned light balls back every step and their collisions pumped a 1,000 kg ball to
+/// 3e19 m/s).
 fn drag_instability<T: Real, const D: usize>(
     scene: &Scene<T, D>,
     integrator: Integrator,
@@ -263,10 +265,10 @@ fn drag_instability<T: Real, const D: usize>(
     let drag = scene.world.drag.to_f64();
     let (i, lightest) = (scene.balls.iter().map(|b| b.mass.to_f64()).enumerate())
         .min_by(|a, b| a.1.total_cmp(&b.1))?;
-    let (kh, limit) = (drag / lightest * dt, integrator.decay_stability_limit());
+    let (kh, limit) = (drag / lightest * dt, integrator.drag_step_limit());
     (drag > 0.0 && kh > limit).then(|| {
         format!(
-            "--dt: {dt} s is too long for --integrator {integrator} under world.drag = {drag}: on balls[{i}] (mass {lightest} kg) drag/mass x dt = {kh:.4} exceeds the scheme's stability limit {limit:.4}, so the ball would speed up step after step; use a step below {:.3e} s or --integrator exact",
+            "--dt: {dt} s is too long for --integrator {integrator} under world.drag = {drag}: on balls[{i}] (mass {lightest} kg) drag/mass x dt = {kh:.4} exceeds the scheme's limit {limit:.4}, beyond which a step turns the ball back or speeds it up; use a step below {:.3e} s or --integrator exact",
             limit * lightest / drag
         )
     })
@@ -436,8 +438,9 @@ mod tests {
 
     #[test]
     fn a_step_too_long_for_the_drag_on_the_lightest_ball_is_refused_or_integrated_exactly() {
-        // Ball 1 weighs a gram: k = drag/m = 200 /s, so k dt = 2 at dt = 1/100 s, the
-        // limit of the Euler schemes and Verlet (RK4: 2.785).
+        // Ball 1 weighs a gram: k = drag/m = 200 /s, so k dt = 1 at dt = 1/200 s, the
+        // limit of the Euler schemes (beyond it their step turns the ball back), and 2
+        // at dt = 1/100 s, Verlet's (RK4: 2.785).
         let mut s = classic::head_on(1.0, 1.0, 1.0, -1.0, 1.0);
         s.balls[1].mass = 1e-3;
         s.world.drag = 0.2;
@@ -446,19 +449,24 @@ mod tests {
             dt: Some(dt),
             ..RunOptions::default()
         };
-        let e = plan(&s, &with(Some(Integrator::SemiImplicitEuler), 0.0101)).unwrap_err();
-        assert!(
-            e.0.starts_with("--dt") && e.0.contains("balls[1]") && e.0.contains("world.drag"),
-            "{e}"
-        );
-        assert!(plan(&s, &with(Some(Integrator::SemiImplicitEuler), 0.0099)).is_ok());
+        for euler in [Integrator::ExplicitEuler, Integrator::SemiImplicitEuler] {
+            let e = plan(&s, &with(Some(euler), 0.00505)).unwrap_err();
+            assert!(
+                e.0.starts_with("--dt") && e.0.contains("balls[1]") && e.0.contains("world.drag"),
+                "{e}"
+            );
+            assert!(plan(&s, &with(Some(euler), 0.00495)).is_ok());
+        }
+        assert!(plan(&s, &with(Some(Integrator::VelocityVerlet), 0.0099)).is_ok());
+        assert!(plan(&s, &with(Some(Integrator::VelocityVerlet), 0.0101)).is_err());
         assert!(plan(&s, &with(Some(Integrator::Rk4), 0.0101)).is_ok());
         assert!(plan(&s, &with(Some(Integrator::Rk4), 0.014)).is_err());
         assert!(plan(&s, &with(Some(Integrator::Exact), 100.0)).is_ok());
-        // Without --integrator the exact one takes over where the default would diverge.
-        let p = plan(&s, &with(None, 0.0101)).unwrap();
+        // Without --integrator the exact one takes over where the default would turn the
+        // ball back.
+        let p = plan(&s, &with(None, 0.00505)).unwrap();
         assert_eq!(p.integrator, Some(Integrator::Exact));
-        let p = plan(&s, &with(None, 0.0099)).unwrap();
+        let p = plan(&s, &with(None, 0.00495)).unwrap();
         assert_eq!(p.integrator, Some(Integrator::SemiImplicitEuler));
     }
 
