@@ -200,3 +200,51 @@ fn a_large_gas_is_validated_quickly_and_accepted() {
     .unwrap();
     scene.validate().unwrap();
 }
+
+/// Two balls of radius 0.016 and 0.020 m in a 3.7 m box whose centre is `(c, c)`.
+fn small_balls_at(c: f64) -> String {
+    format!(
+        r#"
+dim = 2
+[world]
+gravity = [8.16, 2.69]
+[world.border]
+min = [{}, {}]
+max = [{}, {}]
+[[balls]]
+pos = [{}, {}]
+vel = [1.99, 0.029]
+radius = 0.015625
+mass = 77.2
+[[balls]]
+pos = [{}, {}]
+radius = 0.01953125
+mass = 3.87
+"#,
+        c - 1.84375,
+        c - 1.08984375,
+        c + 1.84375,
+        c + 1.08984375,
+        c - 0.3359375,
+        c - 0.8515625,
+        c - 1.390625,
+        c - 0.80859375
+    )
+}
+
+#[test]
+fn a_ball_smaller_than_the_precision_resolves_where_it_is_is_refused_naming_its_radius() {
+    // At 5e4 m f32 resolves 8 ε x = 0.048 m, f64 8.9e-11 m: these balls passed through
+    // each other in f32 there (a fuzzed scene).
+    let LoadedScene::D2(s) = parse_scene(&small_balls_at(-5e4)).expect("valid in f64") else {
+        panic!("a 2D scene")
+    };
+    let e = s.cast::<f32>().expect_err("too small for f32 there");
+    assert_eq!(e.field, "balls[0].radius", "{e}");
+    assert!(e.message.contains("--precision f64"), "{e}");
+    // Near the origin f32 resolves them too.
+    let LoadedScene::D2(s) = parse_scene(&small_balls_at(0.0)).expect("valid") else {
+        panic!("a 2D scene")
+    };
+    s.cast::<f32>().expect("resolved near the origin");
+}

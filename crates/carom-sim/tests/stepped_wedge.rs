@@ -518,3 +518,28 @@ fn a_light_ball_wedged_against_a_wall_by_a_heavy_ball_is_not_taken_for_crushed()
         });
     }
 }
+
+/// A fuzzed scene in `f32` (the third campaign's s46, 30 balls 1,000 m from the origin,
+/// periodic): a 52 mg ball is squeezed between a static box and an 11,423 kg ball coming
+/// down at 3.4e4 m/s, a mass ratio of 2e8, beyond what `f32` resolves (1/ε = 8.4e6), and
+/// the heavy ball is thrown to 2.8e11 m/s. The periodic window, in which no ball may move
+/// more than a quarter of the cell, then ended where it began, and the step repeated it
+/// for ever (the run never returned). The first step now ends with an error naming the
+/// ball and its speed; the same scene in `f64` runs through.
+const F32_SQUEEZE_BEYOND_THE_MASS_RATIO: &str =
+    include_str!("scenes/f32_squeeze_beyond_the_mass_ratio.toml");
+
+#[test]
+fn a_squeeze_beyond_f32s_mass_ratio_ends_with_an_error_not_an_endless_step() {
+    let s = scene_2d(F32_SQUEEZE_BEYOND_THE_MASS_RATIO);
+    let mut sim = stepped(&s.cast::<f32>().unwrap(), Integrator::SemiImplicitEuler, DT);
+    let e = sim.advance_to(DT as f32, &mut ()).unwrap_err();
+    assert!(
+        e.message.starts_with("balls[")
+            && e.message.contains("m/s")
+            && e.message.contains("--precision f64"),
+        "{e}"
+    );
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, DT);
+    sim.advance_to(0.1, &mut ()).unwrap();
+}

@@ -1014,6 +1014,27 @@ where
         )
     }
 
+    /// The error of a periodic window that would end where it starts: at internal time
+    /// `t` a ball moves at `fastest`, so fast that the window in which no ball moves more
+    /// than the periodic reach is shorter than the precision resolves in the step's time.
+    /// Without it the step repeated that empty window for ever: a fuzzed `f32` scene whose
+    /// 52 mg ball was squeezed between a static box and an 11,423 kg ball at 3.4e4 m/s (a
+    /// mass ratio of 2e8, beyond `f32`'s 1/ε) had the heavy ball thrown to 2.8e11 m/s.
+    fn too_fast_for_a_window(&self, t: T, fastest: T) -> SimError {
+        let chord = &self.balls.chord;
+        let ball = (0..chord.len())
+            .find(|&i| chord[i].norm() >= fastest)
+            .unwrap_or_default();
+        SimError::new(
+            (t * self.clock.sign).to_f64(),
+            format!(
+                "balls[{ball}] moves at {:e} m/s: the periodic border's window in which no ball moves more than {:e} m is shorter than this precision resolves within the step, and the run cannot go on (speeds like this follow from squeezes at mass ratios beyond the precision's; try --precision f64)",
+                fastest.to_f64(),
+                self.periodic_reach.to_f64()
+            ),
+        )
+    }
+
     /// The fastest chord of any ball (m/s).
     fn fastest_chord(&self, parallel: bool) -> T {
         let chord = &self.balls.chord;
@@ -1210,6 +1231,9 @@ where
             let boxes = (self.boxes.vel.iter()).fold(T::zero(), |m, v| m.max(v.norm()));
             self.instant = self.instant_width(fastest.max(boxes));
             let b = self.window_end(a, h, fastest);
+            if b <= a {
+                return Err(self.too_fast_for_a_window(t0 + a, fastest));
+            }
             if first {
                 self.sweep
                     .begin_step(&self.balls, &self.boxes, h, self.escape_bound, parallel);
