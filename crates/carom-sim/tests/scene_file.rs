@@ -204,7 +204,7 @@ fn a_large_gas_is_validated_quickly_and_accepted() {
 /// Two balls of radius 0.016 and 0.020 m in a 3.7 m box whose centre is `(c, c)`.
 fn small_balls_at(c: f64) -> String {
     format!(
-        r#"
+        "
 dim = 2
 [world]
 gravity = [8.16, 2.69]
@@ -220,7 +220,7 @@ mass = 77.2
 pos = [{}, {}]
 radius = 0.01953125
 mass = 3.87
-"#,
+",
         c - 1.84375,
         c - 1.08984375,
         c + 1.84375,
