@@ -492,3 +492,39 @@ fn a_ball_resting_on_the_floor_beside_a_very_fast_ball_in_f32_stays_on_it() {
         );
     });
 }
+
+/// A ball falling along a side wall while drifting into it at 5e-8 m/s, below the
+/// resting floor (a millionth of what gravity adds in a step, 9.8e-8 m/s at `dt = 0.01`).
+/// The floor held every wall's contact, so the drift was never a contact and the ball
+/// left the border by 5e-8 m a second (a fuzzed scene: 1.1e-7 m in 2 s). Gravity presses
+/// nothing into a side wall, and the floor now holds a wall's contact only by `|n·ĝ|`: the
+/// ball stays inside at every step, with every integrator.
+#[test]
+fn a_ball_falling_along_a_side_wall_drifting_into_it_slowly_stays_inside() {
+    let r = 0.05;
+    let s = Scene::<f64, 2> {
+        world: World {
+            gravity: Vector2::new(0.0, -9.81),
+            border: Some(BorderSpec {
+                border: Border::new(Vector2::new(-1.0, -10.0), Vector2::new(1.0, 10.0)).unwrap(),
+                restitution: 0.5,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls: vec![BallSpec::new(
+            Vector2::new(-1.0 + r, 9.0),
+            Vector2::new(-5e-8, 0.0),
+            r,
+            1.0,
+        )],
+        ..Scene::default()
+    };
+    each_step(&s, 0.01, 100, |integrator, k, sim| {
+        let outside = outside_border(&s, &states(sim));
+        assert!(
+            outside <= 1e-12,
+            "{integrator}, step {k}: {outside:e} m outside"
+        );
+    });
+}

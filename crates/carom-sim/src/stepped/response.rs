@@ -121,9 +121,15 @@ impl<T: Real, const D: usize> Rules<T, D> {
 
     /// How fast a contact may approach in a step of length `h` and be no contact: the
     /// narrow phase's events and the holds' aim (see [`Allowance`]).
-    pub(crate) fn allowance(&self, h: T) -> Allowance<T> {
+    pub(crate) fn allowance(&self, h: T) -> Allowance<T, D> {
+        let g = self.gravity.norm();
         Allowance {
             resting_floor: self.contact_floor,
+            down: if g > T::zero() {
+                self.gravity / g
+            } else {
+                Vector::zeros()
+            },
             step: h,
         }
     }

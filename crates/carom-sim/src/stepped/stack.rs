@@ -585,8 +585,14 @@ where
             Other::Part(e) => b.chord[e.ball],
         };
         let ball = row.end.ball;
-        let allowed =
-            (self.rules.allowance(self.h)).of(b, ball, row.target, &b.chord[ball], &other);
+        let allowed = (self.rules.allowance(self.h)).of(
+            b,
+            ball,
+            row.target,
+            &b.chord[ball],
+            &other,
+            &row.normal,
+        );
         let floor = self.rules.floor;
         let allowed = if allowed > T::zero() {
             allowed.min(floor)

@@ -147,8 +147,13 @@ where
         let nominal = balls.restitution[i].min(balls.restitution[j]);
         if self.rules.stick && nominal == T::zero() {
             // Where the pair touches on the chords, relative to where the bodies' rigid
-            // poses put the two balls: b's pose moves by the difference (see `fuse`).
+            // poses put the two balls: a free ball's pose moves by the difference, else
+            // b's (see `fuse`).
             let align = (xj - xi) - (self.rigid_place(j) + shift - self.rigid_place(i));
+            let align = match (a, b) {
+                (Side::Ball(_), Side::Cluster(_)) => [-align, Vector::zeros()],
+                _ => [Vector::zeros(), align],
+            };
             self.fuse(a, b, shift, &align, s)?;
             if grouped && s < self.h {
                 let seed = Seed {
@@ -326,27 +331,30 @@ where
     }
 
     /// Fuses sides `a` and `b` (b's members shifted by `shift`) at `s` into one cluster,
-    /// b's rigid pose moved by `align` as well.
+    /// their rigid poses moved by `align` as well (a's, b's).
     ///
     /// A member moves on its chord within a step while its cluster's pose turns it on an
     /// arc (see `clusters`), the two apart by up to the sagitta. Its place on the chord
     /// is where a contact finds it, its place on the arc where the fused cluster would
     /// keep it: fused that way, a ball meeting a turning cluster stayed overlapping its
     /// member by the sagitta for good (up to 1.1e-3 m in fuzzed scenes). `align` moves
-    /// b's pose so that the touching pair keeps, in the fused cluster, the offset it has
-    /// on the chords: exactly touching. The members' places at `s` stay on their chords
-    /// (no jump); their segments end at the fused cluster's rigid places.
+    /// one side's pose so that the touching pair keeps, in the fused cluster, the offset
+    /// it has on the chords: exactly touching. It moves a free ball rather than a
+    /// cluster: moving a cluster that rested on a floor by its member's 3e-5 m took its
+    /// other members into the floor, and a fuzzed scene's holds never ended. The
+    /// members' places at `s` stay on their chords (no jump); their segments end at the
+    /// fused cluster's rigid places.
     fn fuse(
         &mut self,
         a: Side,
         b: Side,
         shift: &Vector<T, D>,
-        align: &Vector<T, D>,
+        [align_a, align_b]: &[Vector<T, D>; 2],
         s: T,
     ) -> Result<(), String> {
         let fusion = self
-            .rigid_of(a, &Vector::zeros())?
-            .fuse(&self.rigid_of(b, &(shift + align))?)
+            .rigid_of(a, align_a)?
+            .fuse(&self.rigid_of(b, &(shift + align_b))?)
             .map_err(|e| format!("fusing a stuck cluster: {e}"))?;
         // Members and their new body-frame offsets: a's, then b's.
         let mut members = Vec::new();
