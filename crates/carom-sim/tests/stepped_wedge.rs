@@ -522,7 +522,7 @@ fn a_light_ball_wedged_against_a_wall_by_a_heavy_ball_is_not_taken_for_crushed()
 /// A fuzzed scene in `f32` (the third campaign's s46, 30 balls 1,000 m from the origin,
 /// periodic): a 52 mg ball is squeezed between a static box and an 11,423 kg ball coming
 /// down at 3.4e4 m/s, a mass ratio of 2e8, beyond what `f32` resolves (1/ε = 8.4e6), and
-/// the heavy ball is thrown to 2.8e11 m/s. The periodic window, in which no ball may move
+/// the heavy ball is thrown to 1.8e8 m/s, the light one to 2.8e11 m/s. The periodic window, in which no ball may move
 /// more than a quarter of the cell, then ended where it began, and the step repeated it
 /// for ever (the run never returned). The first step now ends with an error naming the
 /// ball and its speed; the same scene in `f64` runs through.

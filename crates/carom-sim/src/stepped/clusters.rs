@@ -193,11 +193,12 @@ where
 /// and `ΔL` on the angular momentum, whatever the drag: the field and the drag act on the
 /// free motion `rigid` alone. This is how a held ball's chord takes its push too
 /// (`P/m`, `stack`). Advancing the pushed motion `rigid + push` under drag instead decays
-/// the push with the free motion, by `(1 − e^{−kτ})/(kτ)` with the exact integrator: a
-/// member of a cluster under drag `k = 4,500/s` over the last 2e-3 s of a step took a
-/// tenth of its push, and the hold, whose rounds see the chord that is left, never
-/// stopped it closing on the wall it pressed on (a crush error). Without drag both are the
-/// same, every integrator being linear in the start velocity.
+/// the push with the free motion, by `φ₁(−kτ) = (1 − e^{−kτ})/(kτ)` with the exact
+/// integrator. Measured in a fuzzed scene: a cluster of three balls (9.58 kg) spinning
+/// at 1,733 rad/s, held over sub-steps of 6.2e-6 s with `kτ` = 2.4e-7, took 150 m/s
+/// pushes 1.8e-5 m/s short, and its member kept closing on the wall it pressed on
+/// (1.76e-4 m/s before and after each hold), 16,384 times: a crush error. Without drag
+/// both are the same, every integrator being linear in the start velocity.
 pub(crate) fn advance<T: Real, const D: usize, F: ForceField<T, D>>(
     rigid: &RigidCluster<T, D>,
     push: &Motion<T, D>,

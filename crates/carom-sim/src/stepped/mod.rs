@@ -1019,7 +1019,8 @@ where
     /// than the periodic reach is shorter than the precision resolves in the step's time.
     /// Without it the step repeated that empty window for ever: a fuzzed `f32` scene whose
     /// 52 mg ball was squeezed between a static box and an 11,423 kg ball at 3.4e4 m/s (a
-    /// mass ratio of 2e8, beyond `f32`'s 1/ε) had the heavy ball thrown to 2.8e11 m/s.
+    /// mass ratio of 2e8, beyond `f32`'s 1/ε) had the heavy ball thrown to 1.8e8 m/s and
+    /// the light one to 2.8e11 m/s.
     fn too_fast_for_a_window(&self, t: T, fastest: T) -> SimError {
         let chord = &self.balls.chord;
         let ball = (0..chord.len())

@@ -63,6 +63,8 @@ pub(crate) struct Rules<T: Real, const D: usize> {
     pub(crate) border_restitution: T,
     /// Gravity (the acceleration the resting guard projects on the normal).
     pub(crate) gravity: Vector<T, D>,
+    /// Gravity's unit direction (zero without gravity).
+    pub(crate) down: Vector<T, D>,
     /// The Zeno guard of ball–surface bounces.
     pub(crate) resting: RestingGuard<T>,
     /// The inelastic-collapse guard of ball–ball collisions.
@@ -110,6 +112,11 @@ impl<T: Real, const D: usize> Rules<T, D> {
             friction: world.friction,
             border_restitution: world.border.as_ref().map_or_else(T::one, |b| b.restitution),
             gravity: world.gravity,
+            down: if g > T::zero() {
+                world.gravity / g
+            } else {
+                Vector::zeros()
+            },
             resting: RestingGuard::new(T::lit(2.0) * h).map_err(bad_step)?,
             collapse: CollapseGuard::elastic_below(collapse_speed).map_err(bad_step)?,
             support_speed: T::lit(2.0) * g * h,
@@ -122,14 +129,9 @@ impl<T: Real, const D: usize> Rules<T, D> {
     /// How fast a contact may approach in a step of length `h` and be no contact: the
     /// narrow phase's events and the holds' aim (see [`Allowance`]).
     pub(crate) fn allowance(&self, h: T) -> Allowance<T, D> {
-        let g = self.gravity.norm();
         Allowance {
             resting_floor: self.contact_floor,
-            down: if g > T::zero() {
-                self.gravity / g
-            } else {
-                Vector::zeros()
-            },
+            down: self.down,
             step: h,
         }
     }

@@ -65,7 +65,7 @@ use nalgebra::Const;
 
 use carom_response::RigidCluster;
 
-use super::clusters::{FREE, Motion};
+use super::clusters::{FREE, Flight, Motion};
 use super::narrow::Target;
 use super::response::{Contacts, Effect, touch_tolerance};
 use super::stick::Side;
@@ -73,6 +73,25 @@ use super::sweep::path_box;
 use crate::engine::Angular;
 
 type Inertia<T, const D: usize> = <Const<D> as Space<T, D>>::Inertia;
+
+/// How a change `Δ` of a free ball's chord from in-step time `seg_t` on shows in its
+/// velocity at `seg_t` and at the step's end, as multiples of `Δ`: a constant force over
+/// the rest of the step, `(0, Integrator::end_per_chord)` (`Flight::end_per_chord`); with
+/// explicit Euler, whose chords no force within the step moves, an impulse at `seg_t`,
+/// `(1, 1)`.
+fn shares<T: Real, const D: usize, F: ForceField<T, D>>(
+    flight: &Flight<'_, T, D, F>,
+    inverse_mass: T,
+    seg_t: T,
+) -> (T, T)
+where
+    Const<D>: Space<T, D>,
+{
+    match flight.end_per_chord(inverse_mass, seg_t) {
+        Some(end_share) => (T::zero(), end_share),
+        None => (T::one(), T::one()),
+    }
+}
 
 /// Rounds of the hold against the rotation's second order (see the module
 /// documentation): each removes what the one before left closing, which is of the order
@@ -523,8 +542,7 @@ where
     /// it by the rounding of the hold's sums (8.5e-19 m/s after a hold of a 1 g ball
     /// moving at 175 m/s along the wall) was the same contact again, 16,384 times, and a
     /// false crush error. A wall's normal is an axis: the chord's component along it is set
-    /// exactly, and the end velocity follows as a held force's would
-    /// (`Flight::end_per_chord`). A body that rests on the wall can show no such
+    /// exactly, and the velocities follow as a held force's would ([`shares`]). A body that rests on the wall can show no such
     /// residue in its position (less than the coordinates' resolution over the step).
     fn settle_on_walls(&mut self, stack: &Stack<T, D>, held: &[usize], targets: &[T]) {
         let flight = self.flight();
@@ -543,14 +561,13 @@ where
                 continue;
             }
             let b = &*self.balls;
-            let (mut chord, mut vel) = (b.chord[i], b.vel[i]);
+            let (mut seg_v, mut chord, mut vel) = (b.seg_v[i], b.chord[i], b.vel[i]);
             let change = target * sign - chord[axis];
             chord[axis] = target * sign;
-            let end_share = flight
-                .end_per_chord(b.inverse_mass[i], b.seg_t[i])
-                .unwrap_or_else(T::one);
+            let (start_share, end_share) = shares(&flight, b.inverse_mass[i], b.seg_t[i]);
+            seg_v[axis] += change * start_share;
             vel[axis] += change * end_share;
-            let (seg_v, seg_w, spin) = (b.seg_v[i], b.seg_w[i], b.spin[i]);
+            let (seg_w, spin) = (b.seg_w[i], b.spin[i]);
             self.balls
                 .set_segment(i, self.h, [seg_v, chord, vel], [seg_w, spin]);
         }
@@ -627,12 +644,14 @@ where
         let mut total = vec![Vector::<T, D>::zeros(); held.len()];
         let mut unused = vec![false; stack.rows.len()];
         for _ in 0..HOLD_ROUNDS {
-            if self.closing(stack, held, targets).next().is_none() {
-                break;
-            }
             let mut chords: Vec<_> = (0..stack.rows.len())
                 .map(|c| self.relative(stack, c, Phase::Chord))
                 .collect();
+            let closing = (held.iter().zip(targets))
+                .any(|(&c, &t)| chords[c].dot(&stack.rows[c].normal) - t > self.done(stack, c));
+            if !closing {
+                break;
+            }
             let force = Self::changes(stack, held, &total, &mut unused);
             for &c in held {
                 let moved = (stack.ends(c)).fold(Vector::zeros(), |sum, (e, sign)| {
@@ -673,10 +692,10 @@ where
         changes: &mut Changes<T, D>,
         pushed: &mut [bool],
     ) -> bool {
-        if self.closing(stack, held, targets).next().is_none() {
+        let excess = self.excess(stack, held, targets);
+        if (held.iter().zip(&excess)).all(|(&c, &u)| u <= self.done(stack, c)) {
             return false;
         }
-        let excess = self.excess(stack, held, targets);
         let a = stack.delassus(held, Push::ThroughCentres);
         let q: Vec<T> = excess.iter().map(|&u| -u).collect();
         let mut lambda = vec![T::zero(); held.len()];
@@ -1159,10 +1178,7 @@ where
             match (part.side, part.free) {
                 (Side::Ball(i), Free::Ball([seg_v, chord, vel], [seg_w, spin])) => {
                     let (start_share, end_share) =
-                        match flight.end_per_chord(part.inverse_mass, self.balls.seg_t[i]) {
-                            Some(end_share) => (T::zero(), end_share),
-                            None => (T::one(), T::one()),
-                        };
+                        shares(&flight, part.inverse_mass, self.balls.seg_t[i]);
                     let dw =
                         <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
                     self.balls.set_segment(

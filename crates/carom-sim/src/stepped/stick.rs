@@ -340,8 +340,9 @@ where
     /// member by the sagitta for good (up to 1.1e-3 m in fuzzed scenes). `align` moves
     /// one side's pose so that the touching pair keeps, in the fused cluster, the offset
     /// it has on the chords: exactly touching. It moves a free ball rather than a
-    /// cluster: moving a cluster that rested on a floor by its member's 3e-5 m took its
-    /// other members into the floor, and a fuzzed scene's holds never ended. The
+    /// cluster: moving a cluster that rested on a floor by its member's offset (up to
+    /// 3.1e-5 m in a fuzzed scene) left that scene's step running for over a minute in
+    /// its holds (not traced further), moving the ball did not. The
     /// members' places at `s` stay on their chords (no jump); their segments end at the
     /// fused cluster's rigid places.
     fn fuse(

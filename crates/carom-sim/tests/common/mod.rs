@@ -191,3 +191,24 @@ pub(crate) fn assert_stays_put<const D: usize>(
         );
     }
 }
+
+/// How deep (m) the deepest overlap between two balls of `scene` is (negative when all
+/// are apart; open space, no minimum images).
+pub(crate) fn deepest_overlap<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    states: &BallStates<T, D>,
+) -> f64
+where
+    Const<D>: Space<T, D>,
+{
+    let mut deepest = f64::NEG_INFINITY;
+    for a in 0..scene.balls.len() {
+        for b in a + 1..scene.balls.len() {
+            let gap = (states.pos[b] - states.pos[a]).norm()
+                - scene.balls[a].radius
+                - scene.balls[b].radius;
+            deepest = deepest.max(-gap.to_f64());
+        }
+    }
+    deepest
+}
