@@ -176,7 +176,12 @@ pub(crate) struct Overflow {
 /// squeezing a 1 g ball 1,000 m out) was left by the wedge's hold approaching at 3e-11
 /// m/s along the hold's normal and found approaching at 5.6e-8 m/s along the time of
 /// impact's, a contact again at the same instant, until the run ended with a false
-/// crush error.
+/// crush error. A box's normal at an edge or corner is the direction from its nearest
+/// point to the ball's centre, a radius `r` apart, and at a face the hold's nearest point
+/// and the time of impact's contact point round differently too: it is known to `ρ / r`,
+/// counted the same way (a 23 g ball sliding at 3,000 m/s along a box 1,000 m out,
+/// pressed into it by a 48 kg ball, was held along the hold's normal and found
+/// approaching along the time of impact's, 16,384 times at the first instant).
 ///
 /// A member of a stuck cluster has a chord computed from its rigid places at the
 /// segment's two ends, `(x₁ − x₀)/τ`, each known to `ρ`: its chord is known to `2ρ/τ`,
@@ -217,17 +222,19 @@ where
         normal: &Vector<T, D>,
     ) -> T {
         let speeds = T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm());
+        // The normal's direction, known to `ρ / d` (see the type's documentation).
+        let turned = |d: T| {
+            (u - other_velocity).norm() * coordinate_resolution(balls.seg_x[ball].amax()) / d
+        };
         let rounding = match target {
             Target::Ball(j) => {
                 let j = j as usize;
-                let angle = coordinate_resolution(balls.seg_x[ball].amax())
-                    / (balls.radius[ball] + balls.radius[j]);
                 speeds
-                    + (u - other_velocity).norm() * angle
+                    + turned(balls.radius[ball] + balls.radius[j])
                     + self.member_chord(balls, ball)
                     + self.member_chord(balls, j)
             }
-            Target::Box(_) => speeds + self.member_chord(balls, ball),
+            Target::Box(_) => speeds + turned(balls.radius[ball]) + self.member_chord(balls, ball),
             Target::Border => {
                 let pressed = self.resting_floor * normal.dot(&self.down).abs();
                 return self.member_chord(balls, ball).max(pressed);
