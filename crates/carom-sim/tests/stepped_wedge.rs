@@ -620,18 +620,19 @@ fn a_fast_spinning_ball_meeting_a_heavy_ball_is_neither_taken_for_crushed_nor_st
 
 /// A 23 g ball sliding at 3,000 m/s along the face of a long static box, 1,000 m from
 /// the origin, pressed into it by a 48 kg ball moving along with it (restitution 0
-/// between the balls, 0.754 at the box), at four angles of the box. The box's normal,
-/// taken at the nearest point by the hold and by the time of impact, is known only to
-/// the coordinates' resolution over the radius (1.9e-11 rad here), which turns 3,000 m/s
-/// along the face into up to 5.7e-8 m/s across it; the narrow phase allowed a box
-/// contact only `64 ε` of the speeds (4.3e-11 m/s). What the wedge's hold left resting
-/// along its normal was found approaching along the time of impact's, 16,384 times at
-/// the first instant: a false crush error (at −2.129 rad with explicit Euler, at 1.1 rad
-/// with RK4; the third campaign's s23, whose 0.023 kg ball bounced between a 48 kg ball
-/// and such a box, ended so at 9.7e-3 s with explicit Euler and at 0.169 s with RK4).
-/// A box contact now counts that turn of its normal, as a ball pair does. Every step
-/// with every integrator: no error, the light ball outside the box and apart from the
-/// heavy one (to 1e-9 m), the energy never rising.
+/// between the balls, 0.754 at the box), at four angles of the box. The hold took the
+/// box's normal as the direction from the ball's centre to the box's nearest point in
+/// world coordinates, each known to the coordinates' resolution, so to 1.9e-11 rad here,
+/// which turns 3,000 m/s along the face into up to 5.7e-8 m/s across it; the time of
+/// impact takes the face's axis, and the narrow phase allows a box contact only `64 ε`
+/// of the speeds (4.3e-11 m/s). What the wedge's hold left resting along its normal was
+/// found approaching along the time of impact's, 16,384 times at the first instant: a
+/// false crush error (at −2.129 rad with explicit Euler, at 1.1 rad with RK4; the third
+/// campaign's s23, whose 0.023 kg ball bounced between a 48 kg ball and such a box,
+/// ended so at 9.7e-3 s with explicit Euler and at 0.169 s with RK4). The hold now
+/// takes the normal in the box's frame too. Every step with every integrator: no error,
+/// the light ball outside the box and apart from the heavy one (to 1e-9 m), the energy
+/// never rising.
 fn ball_pressed_along_a_box_face(angle: f64) -> Scene<f64, 2> {
     let normal = Vector2::new(-angle.sin(), angle.cos());
     let along = Vector2::new(angle.cos(), angle.sin());

@@ -19,8 +19,11 @@
 //! wall's, only as far as gravity presses into it): they are the rounding residue of
 //! resting corrections, which would otherwise be corrected again and again without
 //! change. The overlap one can leave is that speed times the step, and is acted on when
-//! the approach grows past it; a fuzzed scene's resting ball, whose approach grew by
-//! 1.5e-8 m/s a step, was left 2.7e-9 m in the floor (docs/stepped.md).
+//! the approach grows past it. A push of another ball that leaves a ball closing on a
+//! wall or box it touches by less is no rounding, and nothing lifts a sunk ball again:
+//! the surface takes it at once (`Contacts::settle_on_surfaces`). Before, a fuzzed
+//! scene's resting ball, pushed into the floor by a light ball at 1.5e-8 to 1.1e-7 m/s
+//! step after step, was left 2.7e-9 m in it (docs/stepped.md).
 //!
 //! In a periodic domain a ball meets the minimum image of another ball (the window is
 //! short enough for it to be the only one that can be reached), and every image of a
@@ -176,12 +179,12 @@ pub(crate) struct Overflow {
 /// squeezing a 1 g ball 1,000 m out) was left by the wedge's hold approaching at 3e-11
 /// m/s along the hold's normal and found approaching at 5.6e-8 m/s along the time of
 /// impact's, a contact again at the same instant, until the run ended with a false
-/// crush error. A box's normal at an edge or corner is the direction from its nearest
-/// point to the ball's centre, a radius `r` apart, and at a face the hold's nearest point
-/// and the time of impact's contact point round differently too: it is known to `ρ / r`,
-/// counted the same way (a 23 g ball sliding at 3,000 m/s along a box 1,000 m out,
-/// pressed into it by a 48 kg ball, was held along the hold's normal and found
-/// approaching along the time of impact's, 16,384 times at the first instant).
+/// crush error. A box's normal at a face counts no such term: the hold and the time of
+/// impact both take it in the box's frame (`BoxArrays::nearest`), where it is the face's
+/// axis exactly. Counting `ρ / r` for boxes instead (tried) let `f32` balls into boxes
+/// 1,000 m out by up to 24 times the coordinates' resolution, where `ρ / r` is 1e-2. At
+/// an edge or a corner the two still take the direction between two points known to
+/// `ρ`; no fuzzed scene has met that.
 ///
 /// A member of a stuck cluster has a chord computed from its rigid places at the
 /// segment's two ends, `(x₁ − x₀)/τ`, each known to `ρ`: its chord is known to `2ρ/τ`,
@@ -222,19 +225,18 @@ where
         normal: &Vector<T, D>,
     ) -> T {
         let speeds = T::lit(64.0) * T::EPSILON * (u.norm() + other_velocity.norm());
-        // The normal's direction, known to `ρ / d` (see the type's documentation).
-        let turned = |d: T| {
-            (u - other_velocity).norm() * coordinate_resolution(balls.seg_x[ball].amax()) / d
-        };
         let rounding = match target {
             Target::Ball(j) => {
                 let j = j as usize;
+                // The normal's direction, known to `ρ / d` (see the type's documentation).
+                let angle = coordinate_resolution(balls.seg_x[ball].amax())
+                    / (balls.radius[ball] + balls.radius[j]);
                 speeds
-                    + turned(balls.radius[ball] + balls.radius[j])
+                    + (u - other_velocity).norm() * angle
                     + self.member_chord(balls, ball)
                     + self.member_chord(balls, j)
             }
-            Target::Box(_) => speeds + turned(balls.radius[ball]) + self.member_chord(balls, ball),
+            Target::Box(_) => speeds + self.member_chord(balls, ball),
             Target::Border => {
                 let pressed = self.resting_floor * normal.dot(&self.down).abs();
                 return self.member_chord(balls, ball).max(pressed);

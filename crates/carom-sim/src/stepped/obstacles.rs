@@ -6,7 +6,6 @@
 //! the end of the step is recomputed from the time its velocity was last set (`k·dt`
 //! style, no running sum), so a box at constant velocity does not drift.
 
-use carom_geometry::query::PointQuery;
 use carom_geometry::{Aabb, Border, Obb};
 use carom_math::{Real, Vector};
 
@@ -63,9 +62,17 @@ impl<T: Real, const D: usize> BoxArrays<T, D> {
         let shift = periodic.map_or_else(Vector::zeros, |border| {
             border.minimum_image(&(obb.center() - x)) - (obb.center() - x)
         });
-        let q = obb.closest_point(&(x - shift)) + shift;
-        let d = (q - x).norm();
-        (d > T::zero()).then(|| ((q - x) / d, d))
+        // In the box's frame, as the time of impact takes it (carom-toi's `ball_obb`):
+        // at a face the offset to the nearest point has one non-zero coordinate, and the
+        // normal is the face's axis exactly, not the direction between two points each
+        // rounded to the world coordinates' resolution (known only to `ρ / r`: a 23 g ball
+        // sliding at 3,000 m/s along a box 1,000 m out, held along such a normal, was
+        // found approaching along the time of impact's at 5.7e-8 m/s, 16,384 times).
+        let local = obb.to_local(&(x - shift));
+        let half = obb.half_extents();
+        let offset = local.inf(&half).sup(&-half) - local;
+        let d = offset.norm();
+        (d > T::zero()).then(|| (obb.vector_to_world(&(offset / d)), d))
     }
 
     /// The box swept by box `k` over the in-step times `[a, b]`.
