@@ -240,9 +240,10 @@ where
     }
 
     /// Changes the chord of ball `i` by `du` (and its spin by `dw`) from the segment start
-    /// on, for a resting contact along the unit normal `n`: the physical velocity shifts
-    /// by the same amount over the whole segment, and its component along `n` becomes the
-    /// chord's, so that a ball held on a surface does not end the step moving into it.
+    /// on, for a resting contact along the unit normal `n`: the velocity and spin at the
+    /// segment's start and end shift by the `(start, end)` shares of the change
+    /// (`stack::shares`), and the velocities' components along `n` become the chord's, so
+    /// that a ball held on a surface does not end the step moving into it.
     pub(crate) fn shift_chord(
         &mut self,
         i: usize,
@@ -250,15 +251,16 @@ where
         du: &Vector<T, D>,
         dw: &Angular<T, D>,
         n: &Vector<T, D>,
+        (start, end): (T, T),
     ) {
         self.chord[i] += du;
         let along = self.chord[i].dot(n);
-        for v in [&mut self.seg_v[i], &mut self.vel[i]] {
-            *v += du;
+        for (v, share) in [(&mut self.seg_v[i], start), (&mut self.vel[i], end)] {
+            *v += du * share;
             *v += n * (along - v.dot(n));
         }
-        self.seg_w[i] += *dw;
-        self.spin[i] += *dw;
+        self.seg_w[i] += *dw * start;
+        self.spin[i] += *dw * end;
         self.pos[i] = self.seg_x[i] + self.chord[i] * (h - self.seg_t[i]);
     }
 }

@@ -80,7 +80,7 @@ type Inertia<T, const D: usize> = <Const<D> as Space<T, D>>::Inertia;
 /// the rest of the step, `(0, Integrator::end_per_chord)` (`Flight::end_per_chord`); with
 /// explicit Euler, whose chords no force within the step moves, an impulse at `seg_t`,
 /// `(1, 1)`.
-fn shares<T: Real, const D: usize, F: ForceField<T, D>>(
+pub(super) fn shares<T: Real, const D: usize, F: ForceField<T, D>>(
     flight: &Flight<'_, T, D, F>,
     inverse_mass: T,
     seg_t: T,
