@@ -23,7 +23,7 @@ use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
 use carom_sim::stepped::StepStats;
 use carom_sim::{BallStates, EngineKind, EventEngine, Simulation};
 use carom_toi::Direction;
-use common::{scene_2d, states, stepped, stepped_with};
+use common::{deepest_overlap, outside_border, scene_2d, states, stepped, stepped_with};
 use nalgebra::{Const, Vector2, Vector3};
 
 const DT: f64 = 0.01;
@@ -94,6 +94,19 @@ where
         e_before = e;
     }
     sim.stats()
+}
+
+/// The energy not risen from `e_before` to `e` (beyond 1e-12 of it), every ball of `s`
+/// inside its border and apart from the others (to 1e-9 m).
+fn assert_held(s: &Scene<f64, 2>, st: &BallStates<f64, 2>, what: &str, e_before: f64, e: f64) {
+    assert!(
+        e <= e_before * (1.0 + 1e-12),
+        "{what}: energy {e_before} -> {e}"
+    );
+    let outside = outside_border(s, st);
+    assert!(outside <= 1e-9, "{what}: a ball {outside:e} m outside");
+    let overlap = deepest_overlap(s, st);
+    assert!(overlap <= 1e-9, "{what}: balls overlap by {overlap:e} m");
 }
 
 /// No two balls of `s` overlapping by more than `tolerance`, every ball inside the
@@ -498,23 +511,13 @@ const LIGHT_BALL_WEDGED_AGAINST_A_WALL: &str =
 #[test]
 fn a_light_ball_wedged_against_a_wall_by_a_heavy_ball_is_not_taken_for_crushed() {
     let s = scene_2d(LIGHT_BALL_WEDGED_AGAINST_A_WALL);
-    let border = s.world.border.as_ref().unwrap().border;
     for integrator in [
         Integrator::VelocityVerlet,
         Integrator::Rk4,
         Integrator::Exact,
     ] {
         run_steps(&s, integrator, 200, |what, st, e_before, e| {
-            assert!(
-                e <= e_before * (1.0 + 1e-12),
-                "{what}: energy {e_before} -> {e}"
-            );
-            for (ball, x) in s.balls.iter().zip(&st.pos) {
-                let inside = (x - border.min()).min().min((border.max() - x).min());
-                assert!(inside >= ball.radius - 1e-9, "{what}: {x} outside");
-            }
-            let gap = (st.pos[1] - st.pos[0]).norm() - s.balls[0].radius - s.balls[1].radius;
-            assert!(gap >= -1e-9, "{what}: overlap {:e}", -gap);
+            assert_held(&s, st, what, e_before, e);
         });
     }
 }
@@ -576,28 +579,12 @@ const LIGHT_BALL_SPINNING_FAST_MEETS_A_HEAVY_BALL: &str =
 #[test]
 fn a_fast_spinning_ball_meeting_a_heavy_ball_is_neither_taken_for_crushed_nor_stopped_dead() {
     let s = scene_2d(LIGHT_BALL_SPINNING_FAST_MEETS_A_HEAVY_BALL);
-    let border = s.world.border.as_ref().unwrap().border;
     for integrator in Integrator::ALL {
         let mut heavy = None;
         let mut step = 0;
         run_steps(&s, integrator, 100, |what, st, e_before, e| {
             step += 1;
-            assert!(
-                e <= e_before * (1.0 + 1e-12),
-                "{what}: energy {e_before} -> {e}"
-            );
-            for (a, (ball, x)) in s.balls.iter().zip(&st.pos).enumerate() {
-                let inside = (x - border.min()).min().min((border.max() - x).min());
-                assert!(inside >= ball.radius - 1e-9, "{what}: {x} outside");
-                for b in a + 1..s.balls.len() {
-                    let gap = (st.pos[b] - x).norm() - ball.radius - s.balls[b].radius;
-                    assert!(
-                        gap >= -1e-9,
-                        "{what}: balls {a} and {b} overlap by {:e}",
-                        -gap
-                    );
-                }
-            }
+            assert_held(&s, st, what, e_before, e);
             if step == 10 {
                 heavy = Some(st.vel[2]);
             }
@@ -671,14 +658,10 @@ fn a_light_ball_pressed_along_a_box_face_far_from_the_origin_is_not_taken_for_cr
         let face = s.boxes[0].shape;
         for integrator in Integrator::ALL {
             run_steps(&s, integrator, 10, |what, st, e_before, e| {
-                assert!(
-                    e <= e_before * (1.0 + 1e-12),
-                    "{angle} rad, {what}: energy {e_before} -> {e}"
-                );
+                let what = format!("{angle} rad, {what}");
+                assert_held(&s, st, &what, e_before, e);
                 let into = s.balls[0].radius - face.signed_distance_to_point(&st.pos[0]);
-                assert!(into <= 1e-9, "{angle} rad, {what}: {into:e} m into the box");
-                let gap = (st.pos[1] - st.pos[0]).norm() - s.balls[0].radius - s.balls[1].radius;
-                assert!(gap >= -1e-9, "{angle} rad, {what}: overlap {:e}", -gap);
+                assert!(into <= 1e-9, "{what}: {into:e} m into the box");
             });
         }
     }

@@ -1037,6 +1037,19 @@ where
     /// `phase`: its slip, for friction. Its normal component is the approach speed, read
     /// to the rounding of the spins' surface speeds: [`Self::approach`] reads it exactly.
     fn relative(&self, stack: &Stack<T, D>, c: usize, phase: Phase) -> Vector<T, D> {
+        self.between(stack, c, phase, Self::end_velocity)
+    }
+
+    /// The velocity of row `c`'s ball end relative to its other end in `phase`, each
+    /// end's read by `velocity` (a contact point's or a centre's); a surface's and a held
+    /// ball's are their own.
+    fn between(
+        &self,
+        stack: &Stack<T, D>,
+        c: usize,
+        phase: Phase,
+        velocity: impl Fn(&Self, &Stack<T, D>, &End<T, D>, Phase) -> Vector<T, D>,
+    ) -> Vector<T, D> {
         let row = &stack.rows[c];
         let other = match row.other {
             Other::Surface(v) => v,
@@ -1044,9 +1057,9 @@ where
                 Phase::Start => self.balls.velocity_at(j, stack.s, self.h).0,
                 Phase::Chord => self.balls.chord[j],
             },
-            Other::Part(e) => self.end_velocity(stack, &e, phase),
+            Other::Part(e) => velocity(self, stack, &e, phase),
         };
-        self.end_velocity(stack, &row.end, phase) - other
+        velocity(self, stack, &row.end, phase) - other
     }
 
     /// How fast row `c` closes in `phase`: the velocities of the two touching balls'
@@ -1065,16 +1078,7 @@ where
     /// ball read 1.4e-12 m/s through every round, which no push changed, and
     /// [`Self::hold`]'s last resort stopped both balls dead.
     fn approach(&self, stack: &Stack<T, D>, c: usize, phase: Phase) -> T {
-        let row = &stack.rows[c];
-        let other = match row.other {
-            Other::Surface(v) => v,
-            Other::Held(j) => match phase {
-                Phase::Start => self.balls.velocity_at(j, stack.s, self.h).0,
-                Phase::Chord => self.balls.chord[j],
-            },
-            Other::Part(e) => self.centre_velocity(stack, &e, phase),
-        };
-        (self.centre_velocity(stack, &row.end, phase) - other).dot(&row.normal)
+        (self.between(stack, c, phase, Self::centre_velocity)).dot(&stack.rows[c].normal)
     }
 
     /// The velocity of the centre of the ball at end `e` in `phase` (its contact point's,
