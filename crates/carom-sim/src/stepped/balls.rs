@@ -242,8 +242,17 @@ where
     /// Changes the chord of ball `i` by `du` (and its spin by `dw`) from the segment start
     /// on, for a resting contact along the unit normal `n`: the velocity and spin at the
     /// segment's start and end shift by the `(start, end)` shares of the change
-    /// (`stack::shares`), and the velocities' components along `n` become the chord's, so
-    /// that a ball held on a surface does not end the step moving into it.
+    /// (`stack::shares`), and the velocity at the segment's start takes the chord's
+    /// component along `n`. So does the end velocity when the change is a force over the
+    /// rest of the step (`start` 0), so that a ball held on a surface does not end the
+    /// step moving into it. An impulse at the segment's start (`start` 1: explicit Euler,
+    /// whose chords no force within the step moves) leaves the end velocity the start's
+    /// plus the rest of the step's forces, as the integrator has it: a resting ball ends
+    /// each step moving into its support at `g h`, and the next step's hold stops that
+    /// approach with its friction. Setting the end's component to the chord's took the
+    /// same normal impulse without friction, and only every other step found the contact
+    /// (the next one starts with no approach): a disk sliding on the floor slowed at
+    /// `μ g / 2`.
     pub(crate) fn shift_chord(
         &mut self,
         i: usize,
@@ -255,9 +264,15 @@ where
     ) {
         self.chord[i] += du;
         let along = self.chord[i].dot(n);
-        for (v, share) in [(&mut self.seg_v[i], start), (&mut self.vel[i], end)] {
+        let held_end = start == T::zero();
+        for (v, share, held) in [
+            (&mut self.seg_v[i], start, true),
+            (&mut self.vel[i], end, held_end),
+        ] {
             *v += du * share;
-            *v += n * (along - v.dot(n));
+            if held {
+                *v += n * (along - v.dot(n));
+            }
         }
         self.seg_w[i] += *dw * start;
         self.spin[i] += *dw * end;
