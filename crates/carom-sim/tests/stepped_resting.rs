@@ -397,3 +397,44 @@ fn a_ball_on_the_floor_pushed_in_by_a_light_ball_sinks_no_more_than_the_narrow_p
         }
     }
 }
+
+/// Two balls rolling side by side on the floor, the one behind faster by 6.7e-8 m/s
+/// (the third campaign's s20 reduced to its two balls, 5e4 m from the origin; here also
+/// near it). That is slower than the floor under which the narrow phase answers no
+/// contact between balls (a millionth of `g h`, 9.8e-8 m/s at `h = 0.01`), whatever the
+/// contact's direction, so the pair sank into each other at that speed: 9.6e-8 m in 2 s
+/// with every integrator. A pair overlapping deeper than that floor lets a contact sink
+/// in a step (`Allowance::sunk_depth`: 9.8e-10 m, plus the contacts' rounding) now has
+/// any approach beyond rounding answered. Every step for 2 s, every integrator, both
+/// places: no deeper than twice that depth plus a step at the pair's approach.
+#[test]
+fn balls_rolling_side_by_side_closing_slower_than_the_resting_floor_do_not_sink_into_each_other() {
+    let (r, v, faster, dt) = (0.05, 0.64, 6.7e-8, 0.01);
+    for x0 in [0.0, 5e4] {
+        let mut world = floor_world(0.5, 0.3, 20.0);
+        world.border = Some(BorderSpec {
+            border: Border::new(Vector2::new(x0 - 10.0, 0.0), Vector2::new(x0 + 10.0, 10.0))
+                .unwrap(),
+            restitution: 0.5,
+            periodic: false,
+        });
+        let s = Scene {
+            world,
+            balls: vec![
+                BallSpec::new(Vector2::new(x0, r), Vector2::new(v + faster, 0.0), r, 1.0),
+                BallSpec::new(Vector2::new(x0 + 2.0 * r, r), Vector2::new(v, 0.0), r, 1.0),
+            ],
+            ..Scene::default()
+        };
+        let rounding = |x: f64| 1e-9 * r + 16.0 * f64::EPSILON * (x + r);
+        let floor_depth = 1e-6 * G * dt * dt + 2.0 * rounding(x0 + 1.0);
+        let allowed = 2.0 * floor_depth + faster * dt;
+        common::each_step(&s, dt, 200, |integrator, k, sim| {
+            let overlap = common::deepest_overlap(&s, &states(sim));
+            assert!(
+                overlap <= allowed,
+                "{integrator}, {x0} m out, step {k}: overlap {overlap:e} m (allowed {allowed:e})"
+            );
+        });
+    }
+}

@@ -66,10 +66,10 @@ use self::balls::BallArrays;
 use self::clusters::{Clusters, Flight};
 use self::forces::WorldForces;
 use self::lcp::Lcp;
-use self::narrow::{Event, Narrow, Overflow, Target};
+use self::narrow::{Event, Narrow, Overflow, Target, apart_speed, touch_tolerance};
 use self::obstacles::BoxArrays;
 use self::queue::EventQueue;
-use self::response::{Contacts, Effect, RestSets, Rules, Surface, touch_tolerance};
+use self::response::{Contacts, Effect, RestSets, Rules, Surface};
 use self::rest::{Support, Touch};
 use self::stack::{Groups, SeedOther};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
@@ -742,7 +742,7 @@ where
         for (ball, out) in [i, other].into_iter().zip(touches.iter_mut()) {
             out.clear();
             if self.rules.gravity != Vector::<T, D>::zeros() {
-                self.gather(ball, e.time, out);
+                self.gather(ball, e.time, h, out);
             }
         }
         let in_cluster = |b: &BallArrays<T, D>, k: usize| Clusters::of(b, k).is_some();
@@ -834,8 +834,8 @@ where
 
     /// The supports ball `i` touches at in-step time `s` (within `1e-9` of its radius):
     /// walls of the border, boxes, and balls below it (along gravity) that do not move
-    /// up into it.
-    fn gather(&mut self, i: usize, s: T, out: &mut Vec<Touch<T, D>>) {
+    /// up into it (`h` the step's length).
+    fn gather(&mut self, i: usize, s: T, h: T, out: &mut Vec<Touch<T, D>>) {
         let b = &self.balls;
         let (x, r) = (b.position_at(i, s), b.radius[i]);
         let tolerance = touch_tolerance(&x, r);
@@ -901,10 +901,14 @@ where
             if self.rules.lies_below((&x, r), (&y, b.radius[j]))
                 && b.chord[j].dot(&normal) >= -self.rules.floor
             {
+                // A pair sunk deeper than the narrow phase lets is held apart (see
+                // `narrow::Allowance`): the support recedes at that speed.
+                let allowance = self.rules.allowance(h);
+                let apart = apart_speed(&allowance, (&x, r), (&y, b.radius[j]), h - s);
                 out.push(Touch {
                     support: Support::Ball(j as u32),
                     normal,
-                    velocity: b.chord[j],
+                    velocity: b.chord[j] - normal * apart,
                 });
             }
         }

@@ -46,7 +46,7 @@ use nalgebra::Const;
 use super::balls::BallArrays;
 use super::clusters::{Clusters, Flight};
 use super::lcp::Lcp;
-use super::narrow::{Allowance, Target};
+use super::narrow::{Allowance, Target, apart_speed, touch_tolerance};
 use super::obstacles::BoxArrays;
 use super::rest::{RestSet, Support, Touch};
 use super::stack::Groups;
@@ -161,12 +161,6 @@ impl<T: Real, const D: usize> Rules<T, D> {
 /// coordinates near 2 m to 2.4e-7 m. A contact within 1e-4 rad of the horizontal takes
 /// at most 1e-4 of its push as support: it is a side contact, not a support.
 pub(crate) const SIDE_BY_SIDE: f64 = 1e-4;
-
-/// The gap within which a ball of radius `r` at `x` touches a surface or a ball: a
-/// billionth of its radius plus the rounding of its coordinates.
-pub(crate) fn touch_tolerance<T: Real, const D: usize>(x: &Vector<T, D>, r: T) -> T {
-    T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (x.amax() + r)
-}
 
 /// What a processed contact did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -405,12 +399,23 @@ where
         if (b.chord[j] - b.chord[i]).dot(&n) >= T::zero() || s >= h {
             return effect;
         }
+        // A pair sunk deeper than the narrow phase lets a contact sink is held apart at
+        // its depth over the rest of the step (see `Allowance`): the support is taken to
+        // recede at that speed.
+        let apart = apart_speed(
+            &self.rules.allowance(h),
+            (&b.position_at(i, s), b.radius[i]),
+            (&(b.position_at(j, s) + shift), b.radius[j]),
+            h - s,
+        );
         // Shock propagation: a ball resting on a supported ball below it, that does not
         // move towards it, is held as by an immovable surface, and is supported in turn.
         if self.holds_up(i, j, s) {
-            self.rest_on(i, Support::Ball(j as u32), &n, b.chord[j], b.seg_w[j], s);
+            let support = b.chord[j] - n * apart;
+            self.rest_on(i, Support::Ball(j as u32), &n, support, b.seg_w[j], s);
         } else if self.holds_up(j, i, s) {
-            self.rest_on(j, Support::Ball(i as u32), &-n, b.chord[i], b.seg_w[i], s);
+            let support = b.chord[i] + n * apart;
+            self.rest_on(j, Support::Ball(i as u32), &-n, support, b.seg_w[i], s);
         } else {
             // Two free balls closing along their chords: a perfectly inelastic correction
             // (momentum kept, energy never added).

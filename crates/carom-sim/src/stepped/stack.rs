@@ -55,8 +55,11 @@
 //! hold changes the energy at the step's end by `ΔE = 2 Σ P·u'` summed over the bodies
 //! (`u'` the held chords, `P` the impulses), which is `−2 Σ λ g/τ <= 0` over the
 //! contacts (a contact pushes only where its chords close exactly at its margin): the
-//! hold never adds energy, to first order in the rotation. The impacts are inelastic
-//! impulses at `s`, which only take energy.
+//! hold never adds energy, to first order in the rotation, but where a margin is
+//! negative: two balls sunk into each other deeper than the narrow phase's
+//! floor lets a contact sink (`narrow::sunk`) are aimed apart at their depth over the
+//! rest of the step (`−g/τ`), and the push that does it adds `2 λ |g|/τ`. The impacts are
+//! inelastic impulses at `s`, which only take energy.
 
 use carom_geometry::Ball;
 use carom_integrate::ForceField;
@@ -66,8 +69,8 @@ use nalgebra::Const;
 use carom_response::RigidCluster;
 
 use super::clusters::{FREE, Flight, Motion};
-use super::narrow::Target;
-use super::response::{Contacts, Effect, touch_tolerance};
+use super::narrow::{Target, sunk, touch_tolerance};
+use super::response::{Contacts, Effect};
 use super::stick::Side;
 use super::sweep::path_box;
 use crate::engine::Angular;
@@ -939,6 +942,15 @@ where
             } else {
                 gap
             };
+            // Overlapping: held closing at most to touching, unless sunk deeper than the
+            // floor lets a contact sink (see `Allowance`), where the narrow phase answers
+            // any approach beyond rounding: such a pair is aimed apart over the rest of
+            // the step, so that no hold leaves it closing.
+            let allowance = self.rules.allowance(self.h);
+            let held_gap = match sunk(&allowance, (&p, r), (&y, b.radius[j])) {
+                Some(_) => gap,
+                None => gap.max(T::zero()),
+            };
             if !near(gap, (chord - b.chord[j]).dot(&n)) {
                 continue;
             }
@@ -952,7 +964,7 @@ where
                         other: Other::Held(j),
                         target: Target::Ball(j as u32),
                         normal: n,
-                        gap: gap.max(T::zero()),
+                        gap: held_gap,
                     });
                     continue;
                 }
@@ -979,7 +991,7 @@ where
                     lever: point - y,
                 }),
                 normal: n,
-                gap: gap.max(T::zero()),
+                gap: held_gap,
             });
         }
         *self.candidates = candidates;
