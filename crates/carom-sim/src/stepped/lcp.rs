@@ -73,6 +73,16 @@ fn dependence_threshold<T: Real>() -> T {
     (T::lit(DEPENDENT) * T::EPSILON).min(T::lit(DEPENDENT_FLOOR))
 }
 
+/// The mass ratio between two bodies in contact beyond which precision `T` cannot hold
+/// their contacts: a ratio `r` leaves pivots of about `1/r` (see [`DEPENDENT`]), which
+/// the solve takes for dependence below [`dependence_threshold`], and which rounding
+/// takes away below `T::EPSILON` (`1/m_light + 1/m_heavy` rounds to `1/m_light`).
+/// Measured with a heavy ball dropped onto a 1 g ball on the floor: held up to 1e4 kg
+/// in `f32` (limit 8.4e6) and 2e9 kg in `f64` (limit 4.4e12), crushed from 3e4 and 5e9 kg.
+pub(crate) fn resolvable_mass_ratio<T: Real>() -> T {
+    T::one() / dependence_threshold::<T>().max(T::EPSILON)
+}
+
 /// Scratch of [`Lcp::solve`], kept between calls.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Lcp<T: Real> {

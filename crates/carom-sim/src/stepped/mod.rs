@@ -715,6 +715,7 @@ where
             repeat = repeat.max(self.repeats.note(other, e.time, instant, link));
         }
         if repeat == Repeat::Crushed {
+            let reason = self.crush_reason(i, e.time);
             let by = match e.target {
                 Target::Ball(j) => format!("balls[{j}]"),
                 Target::Border => "the border".to_string(),
@@ -723,7 +724,7 @@ where
             return Err(SimError::new(
                 ((t0 + e.time) * self.clock.sign + T::zero()).to_f64(),
                 format!(
-                    "balls[{i}] is crushed: more than {CRUSH_CONTACTS} contacts at one instant (the last with {by}), even held against all of them at once: it cannot give way (as when a kinematic box presses it into the border or another box from every side it could leave by)"
+                    "balls[{i}] is crushed: more than {CRUSH_CONTACTS} contacts at one instant (the last with {by}), even held against all of them at once: {reason}"
                 ),
             ));
         }
@@ -855,47 +856,20 @@ where
                 }
             }
         }
-        let n = b.len();
         let path = path_box(&x, &b.pos[i], r + tolerance);
         let mut candidates = core::mem::take(&mut self.candidates);
         self.sweep.candidates(i, &path, &mut candidates);
         // Ascending, each once: the supports come in index order whatever the source.
         candidates.sort_unstable();
         candidates.dedup();
-        let boxes = if self.sweep.boxes_inside() {
-            None
-        } else {
-            Some(0..self.boxes.len())
-        };
-        let box_ids = candidates
-            .iter()
-            .filter(|&&c| c as usize >= n)
-            .map(|&c| c as usize - n)
-            .chain(boxes.into_iter().flatten());
-        for k in box_ids {
-            let Some((normal, d)) = self.boxes.nearest(k, s, &x, self.periodic.as_ref()) else {
-                continue;
-            };
-            if d - r <= tolerance {
-                out.push(Touch {
-                    support: Support::Box(k as u32),
-                    normal,
-                    velocity: self.boxes.vel[k],
-                });
-            }
+        for (k, normal) in self.touching_boxes((&x, r), s, tolerance, &candidates) {
+            out.push(Touch {
+                support: Support::Box(k as u32),
+                normal,
+                velocity: self.boxes.vel[k],
+            });
         }
-        for &c in candidates.iter().filter(|&&c| (c as usize) < n) {
-            let j = c as usize;
-            if j == i {
-                continue;
-            }
-            let y = b.position_at(j, s);
-            let y = self.periodic.map_or(y, |p| x + p.minimum_image(&(y - x)));
-            let d = (y - x).norm();
-            if !(d > T::zero() && d - r - b.radius[j] <= tolerance) {
-                continue;
-            }
-            let normal = (y - x) / d;
+        for (j, y, normal) in self.touching_balls(i, (&x, r), s, tolerance, &candidates) {
             // Below the ball (not beside it on a common floor), and not moving up into it
             // (within rounding): it can hold it.
             if self.rules.lies_below((&x, r), (&y, b.radius[j]))
@@ -913,6 +887,104 @@ where
             }
         }
         self.candidates = candidates;
+    }
+
+    /// The boxes among `candidates` (indices past the balls'; every box where the broad
+    /// phase does not file them) that a ball (centre and radius) touches at in-step time
+    /// `s` within `tolerance`: each with the unit normal from the ball into it.
+    fn touching_boxes<'a>(
+        &'a self,
+        (x, r): (&'a Vector<T, D>, T),
+        s: T,
+        tolerance: T,
+        candidates: &'a [u32],
+    ) -> impl Iterator<Item = (usize, Vector<T, D>)> + 'a {
+        let n = self.balls.len();
+        let unfiled = (!self.sweep.boxes_inside()).then_some(0..self.boxes.len());
+        candidates
+            .iter()
+            .filter(move |&&c| c as usize >= n)
+            .map(move |&c| c as usize - n)
+            .chain(unfiled.into_iter().flatten())
+            .filter_map(move |k| {
+                let (normal, d) = self.boxes.nearest(k, s, x, self.periodic.as_ref())?;
+                (d - r <= tolerance).then_some((k, normal))
+            })
+    }
+
+    /// The balls among `candidates` (indices, boxes' included) that touch ball `i` (centre
+    /// and radius) at in-step time `s` within `tolerance`: each with its centre (the
+    /// minimum image seen from ball `i`'s in a periodic domain) and the unit normal from
+    /// ball `i` to it.
+    fn touching_balls<'a>(
+        &'a self,
+        i: usize,
+        (x, r): (&'a Vector<T, D>, T),
+        s: T,
+        tolerance: T,
+        candidates: &'a [u32],
+    ) -> impl Iterator<Item = (usize, Vector<T, D>, Vector<T, D>)> + 'a {
+        let b = &self.balls;
+        candidates
+            .iter()
+            .map(|&c| c as usize)
+            .filter(move |&j| j < b.len() && j != i)
+            .filter_map(move |j| {
+                let y = b.position_at(j, s);
+                let y = self.periodic.map_or(y, |p| x + p.minimum_image(&(y - x)));
+                let d = (y - x).norm();
+                (d > T::zero() && d - r - b.radius[j] <= tolerance).then(|| (j, y, (y - x) / d))
+            })
+    }
+
+    /// Why ball `i` could not be held at in-step time `s`, for a crush error: where no box
+    /// it touches moves and a ball it touches is heavier or lighter by more than the
+    /// precision resolves (`lcp::resolvable_mass_ratio`), the mass ratio; otherwise that
+    /// the ball cannot give way.
+    fn crush_reason(&mut self, i: usize, s: T) -> String {
+        let cannot_give_way = "it cannot give way (as when a kinematic box presses it into the border or another box from every side it could leave by)".to_string();
+        let b = &self.balls;
+        let (x, r) = (b.position_at(i, s), b.radius[i]);
+        let tolerance = touch_tolerance(&x, r);
+        let mut candidates = core::mem::take(&mut self.candidates);
+        self.sweep
+            .candidates(i, &path_box(&x, &b.pos[i], r + tolerance), &mut candidates);
+        let pressed_by_a_box = self
+            .touching_boxes((&x, r), s, tolerance, &candidates)
+            .any(|(k, _)| self.boxes.vel[k] != Vector::<T, D>::zeros());
+        let ratio = |j: usize| {
+            let (m, n) = (b.inverse_mass[i], b.inverse_mass[j]);
+            (m / n).max(n / m)
+        };
+        let widest = self
+            .touching_balls(i, (&x, r), s, tolerance, &candidates)
+            .map(|(j, ..)| (j, ratio(j)))
+            .fold(None, |w: Option<(usize, T)>, (j, q)| match w {
+                Some((_, best)) if best >= q => w,
+                _ => Some((j, q)),
+            });
+        self.candidates = candidates;
+        let limit = lcp::resolvable_mass_ratio::<T>();
+        match widest {
+            Some((j, q)) if q > limit && !pressed_by_a_box => {
+                let precision = if T::EPSILON.to_f64() > f64::EPSILON {
+                    "f32"
+                } else {
+                    "f64"
+                };
+                let advice = if precision == "f32" {
+                    "--precision f64 or masses closer together"
+                } else {
+                    "masses closer together"
+                };
+                format!(
+                    "no box it touches moves, but balls[{j}] touching it differs from it in mass by a factor {:.2e}, beyond the {:.0e} that {precision} resolves: the lighter ball's share of the contacts' impulses is lost to rounding, and they cannot be held (try {advice})",
+                    q.to_f64(),
+                    limit.to_f64()
+                )
+            }
+            _ => cannot_give_way,
+        }
     }
 
     /// Stops every ball and cluster at in-step time `s` for the rest of the step

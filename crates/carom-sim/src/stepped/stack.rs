@@ -948,8 +948,8 @@ where
             // the step, so that no hold leaves it closing.
             let allowance = self.rules.allowance(self.h);
             let held_gap = match sunk(&allowance, (&p, r), (&y, b.radius[j])) {
-                Some(_) => gap,
-                None => gap.max(T::zero()),
+                Some(depth) => -depth,
+                None => gap,
             };
             if !near(gap, (chord - b.chord[j]).dot(&n)) {
                 continue;
