@@ -416,16 +416,20 @@ where
         }
         let u = &self.balls.chord[ball];
         let approach = (u - other_velocity).dot(&toi.normal);
-        let allowed = match (toi.status, target) {
-            (Status::AlreadyTouching, Target::Ball(j))
-                if self.sunk(ball, j as usize, s, &shift) =>
-            {
-                (self.allowance).rounding(self.balls, ball, target, u, other_velocity)
+        let allowance = &self.allowance;
+        if approach <= allowance.of(self.balls, ball, target, u, other_velocity, &toi.normal) {
+            // Within the floor: no contact, but for a pair sunk deeper than it lets a
+            // contact sink, which is allowed only rounding (checked last: rarely needed).
+            let sunk = match (toi.status, target) {
+                (Status::AlreadyTouching, Target::Ball(j)) => {
+                    approach > allowance.rounding(self.balls, ball, target, u, other_velocity)
+                        && self.sunk(ball, j as usize, s, &shift)
+                }
+                _ => false,
+            };
+            if !sunk {
+                return Ok(None);
             }
-            _ => (self.allowance).of(self.balls, ball, target, u, other_velocity, &toi.normal),
-        };
-        if approach <= allowed {
-            return Ok(None);
         }
         let time = (s + toi.time).min(self.end);
         let x = self.balls.position_at(ball, time);
