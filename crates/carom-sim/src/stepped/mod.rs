@@ -869,6 +869,7 @@ where
                 velocity: self.boxes.vel[k],
             });
         }
+        let allowance = self.rules.allowance(h);
         for (j, y, normal) in self.touching_balls(i, (&x, r), s, tolerance, &candidates) {
             // Below the ball (not beside it on a common floor), and not moving up into it
             // (within rounding): it can hold it.
@@ -877,7 +878,6 @@ where
             {
                 // A pair sunk deeper than the narrow phase lets is held apart (see
                 // `narrow::Allowance`): the support recedes at that speed.
-                let allowance = self.rules.allowance(h);
                 let apart = apart_speed(&allowance, (&x, r), (&y, b.radius[j]), h - s);
                 out.push(Touch {
                     support: Support::Ball(j as u32),

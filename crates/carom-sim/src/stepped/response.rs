@@ -402,10 +402,11 @@ where
         // A pair sunk deeper than the narrow phase lets a contact sink is held apart at
         // its depth over the rest of the step (see `Allowance`): the support is taken to
         // recede at that speed.
+        // Both balls restarted at `s`: their segments start where they are now.
         let apart = apart_speed(
             &self.rules.allowance(h),
-            (&b.position_at(i, s), b.radius[i]),
-            (&(b.position_at(j, s) + shift), b.radius[j]),
+            (&b.seg_x[i], b.radius[i]),
+            (&(b.seg_x[j] + shift), b.radius[j]),
             h - s,
         );
         // Shock propagation: a ball resting on a supported ball below it, that does not

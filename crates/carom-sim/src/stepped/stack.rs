@@ -915,6 +915,7 @@ where
         candidates.dedup();
         let n_balls = self.balls.len();
         let cluster_body = matches!(stack.parts[k].side, Side::Cluster(_));
+        let allowance = self.rules.allowance(self.h);
         for &j in &candidates {
             let j = j as usize;
             if j >= n_balls || j == x || self.side(j) == self.side(x) {
@@ -942,18 +943,17 @@ where
             } else {
                 gap
             };
+            if !near(gap, (chord - b.chord[j]).dot(&n)) {
+                continue;
+            }
             // Overlapping: held closing at most to touching, unless sunk deeper than the
             // floor lets a contact sink (see `Allowance`), where the narrow phase answers
             // any approach beyond rounding: such a pair is aimed apart over the rest of
             // the step, so that no hold leaves it closing.
-            let allowance = self.rules.allowance(self.h);
             let held_gap = match sunk(&allowance, (&p, r), (&y, b.radius[j])) {
                 Some(depth) => -depth,
                 None => gap,
             };
-            if !near(gap, (chord - b.chord[j]).dot(&n)) {
-                continue;
-            }
             let side = self.side(j);
             let other = match (stack.find(side), side) {
                 (Some(o), _) if o <= k => continue,
