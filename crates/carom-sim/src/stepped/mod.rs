@@ -657,13 +657,17 @@ where
 
     /// Prefetches what answering the next contacts will read, in three stages so that
     /// each stage's reads hit the lines the one before fetched: three contacts ahead
-    /// their balls' rows, entries and partner-list starts; two ahead the partner lists;
+    /// their balls' rows, entries and partner-list starts, and their records in the
+    /// step's bookkeeping (repeats, resting sets, groups); two ahead the partner lists;
     /// one ahead the partners' rows (see `queue` and `prefetch`). A hint only.
     fn prefetch_ahead(&self) {
         if let Some(e) = self.queue.ahead(2) {
             for ball in e.balls() {
                 self.balls.prefetch_row(ball);
                 self.sweep.prefetch_entry(ball);
+                self.repeats.prefetch(ball);
+                self.rest.prefetch(ball);
+                self.groups.prefetch(ball);
             }
         }
         if let Some(e) = self.queue.ahead(1) {

@@ -52,6 +52,7 @@ use super::rest::{RestSet, Support, Touch};
 use super::stack::Groups;
 use super::sweep::Sweep;
 use crate::engine::Angular;
+use crate::prefetch::prefetch;
 use crate::scene::{Inelastic, Scene, SceneError};
 
 /// The rules of a scene's contacts.
@@ -201,6 +202,12 @@ impl<T: Real, const D: usize> RestSets<T, D> {
             self.slot[*ball as usize] = u32::MAX;
         }
         self.sets.clear();
+    }
+
+    /// Prefetches ball `i`'s entry in the sparse index (see `prefetch`): every contact
+    /// reads it.
+    pub(crate) fn prefetch(&self, i: usize) {
+        prefetch(&self.slot[i]);
     }
 
     /// Ball `i`'s set for the instant `s`, started afresh from `chord` if it was for

@@ -74,6 +74,7 @@ use super::response::{Contacts, Effect};
 use super::stick::Side;
 use super::sweep::path_box;
 use crate::engine::Angular;
+use crate::prefetch::prefetch;
 use crate::scene::coordinate_resolution;
 
 type Inertia<T, const D: usize> = <Const<D> as Space<T, D>>::Inertia;
@@ -273,6 +274,11 @@ impl Groups {
             }
         }
         self.balls.clear();
+    }
+
+    /// Prefetches ball `i`'s group (see `prefetch`): every contact reads it.
+    pub(crate) fn prefetch(&self, i: usize) {
+        prefetch(&self.of[i]);
     }
 
     /// Whether ball `i` is held with other bodies in this step.

@@ -35,6 +35,8 @@
 
 use carom_math::Real;
 
+use crate::prefetch::prefetch;
+
 /// Contacts of one ball at one instant beyond which it is wedged. Elastic chains end in
 /// far fewer: a column of `k` balls settles in `k(k+1)/2` contacts, `k` for each ball.
 pub(crate) const WEDGE_CONTACTS: u32 = 256;
@@ -54,15 +56,23 @@ pub(crate) enum Repeat {
     Crushed,
 }
 
+/// One ball's record in [`Repeats`]: the instant its recent contacts cluster around and
+/// how many it had there, and the time of its last contact and how many it has had in a
+/// chain, each within a link (`note`'s `link`) of the one before. One record per ball
+/// (not one array per field) so that a contact reads one cache line of each ball, which
+/// the event loop prefetches ([`Repeats::prefetch`]).
+#[derive(Clone, Copy, Debug, Default)]
+struct Record<T> {
+    anchor: T,
+    last: T,
+    count: u32,
+    chain: u32,
+}
+
 /// Per ball, the instant its recent contacts cluster around and how many it had there.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Repeats<T> {
-    anchor: Vec<T>,
-    count: Vec<u32>,
-    /// The time of each ball's last contact, and how many it has had in a chain, each
-    /// within a link (`note`'s `link`) of the one before.
-    last: Vec<T>,
-    chain: Vec<u32>,
+    records: Vec<Record<T>>,
     /// The balls with a non-zero count (to forget in [`Self::clear`]).
     noted: Vec<u32>,
 }
@@ -71,10 +81,7 @@ impl<T: Real> Repeats<T> {
     /// No contacts yet, for `n` balls.
     pub(crate) fn new(n: usize) -> Self {
         Self {
-            anchor: vec![T::zero(); n],
-            count: vec![0; n],
-            last: vec![T::zero(); n],
-            chain: vec![0; n],
+            records: vec![Record::default(); n],
             noted: Vec::new(),
         }
     }
@@ -82,10 +89,16 @@ impl<T: Real> Repeats<T> {
     /// Forgets every contact (at the start of a step).
     pub(crate) fn clear(&mut self) {
         for &i in &self.noted {
-            self.count[i as usize] = 0;
-            self.chain[i as usize] = 0;
+            let record = &mut self.records[i as usize];
+            record.count = 0;
+            record.chain = 0;
         }
         self.noted.clear();
+    }
+
+    /// Prefetches ball `i`'s record (see `prefetch`).
+    pub(crate) fn prefetch(&self, i: usize) {
+        prefetch(&self.records[i]);
     }
 
     /// Notes a contact of ball `i` at in-step time `s` and tells what its contacts within
@@ -93,26 +106,24 @@ impl<T: Real> Repeats<T> {
     /// instant), and its chain of contacts each within `link` of the one before: a chain
     /// longer than [`WEDGE_CONTACTS`] wedges it too.
     pub(crate) fn note(&mut self, i: usize, s: T, tolerance: T, link: T) -> Repeat {
-        let fresh = self.count[i] == 0;
+        let record = &mut self.records[i];
+        let fresh = record.count == 0;
         if fresh {
             self.noted.push(i as u32);
         }
-        let count = &mut self.count[i];
-        if fresh || (s - self.anchor[i]).abs() > tolerance {
-            self.anchor[i] = s;
-            *count = 1;
+        if fresh || (s - record.anchor).abs() > tolerance {
+            record.anchor = s;
+            record.count = 1;
         } else {
-            *count = count.saturating_add(1);
+            record.count = record.count.saturating_add(1);
         }
-        let count = *count;
-        let chain = &mut self.chain[i];
-        if fresh || (s - self.last[i]).abs() > link {
-            *chain = 1;
+        if fresh || (s - record.last).abs() > link {
+            record.chain = 1;
         } else {
-            *chain = chain.saturating_add(1);
+            record.chain = record.chain.saturating_add(1);
         }
-        self.last[i] = s;
-        match (count, *chain) {
+        record.last = s;
+        match (record.count, record.chain) {
             (c, _) if c > CRUSH_CONTACTS => Repeat::Crushed,
             (c, k) if c > WEDGE_CONTACTS || k > WEDGE_CONTACTS => Repeat::Wedged,
             _ => Repeat::Free,
