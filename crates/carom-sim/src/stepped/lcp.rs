@@ -46,61 +46,55 @@
 //! contact closing after every hold and was held again at the same instant to the event
 //! budget (every step, 20,000 events).
 
-use carom_math::Real;
-
-/// A Cholesky pivot (squared) below `DEPENDENT` roundings (`T::EPSILON`), or below
-/// [`DEPENDENT_FLOOR`] if that is smaller, on the unit-diagonal scaled matrix, marks a
-/// contact as dependent on the passive ones (see the module documentation). Exact
-/// dependence leaves a few roundings (~1e-16 in `f64`); a mass ratio `r` between the
-/// bodies of two contacts leaves pivots of about `1/r`. In `f64` (threshold 2.3e-13)
-/// contacts are independent up to `r` ≈ 4e12, which covers the scene contract's 1e-6 kg
-/// ball pressed into a wall by a 1e6 kg ball (`r` = 1e12: a threshold of 1e-11 called
-/// its two contacts dependent, left the wall's contact closing, and the ball was held
-/// again at the same instant until the crush limit).
+/// A Cholesky pivot (squared) below `DEPENDENT` roundings on the unit-diagonal scaled
+/// matrix marks a contact as dependent on the passive ones (see the module
+/// documentation): [`DEPENDENCE_THRESHOLD`]. Exact dependence leaves a few roundings
+/// (~1e-16); a mass ratio `r` between the bodies of two contacts leaves pivots of about
+/// `1/r`, so contacts are independent up to `r` ≈ 4e12. That covers the scene
+/// contract's 1e-6 kg ball pressed into a wall by a 1e6 kg ball (`r` = 1e12: a threshold
+/// of 1e-11 called its two contacts dependent, left the wall's contact closing, and the
+/// ball was held again at the same instant until the crush limit).
+///
+/// The problems are solved in `f64` whatever the scene's precision (the stack builds
+/// them in `f64`: `stack::Wide`). In `f32`, whose roundings (~1e-7) cannot tell
+/// dependence from a mass ratio above 1e4, the threshold then treats a contact that
+/// depends on others to `f32`'s rounding as independent, which costs a poorly
+/// conditioned solve, where treating a mass ratio as dependence would leave a contact
+/// closing (measured when the solve was in `f32`: a threshold of 1024 `f32` roundings,
+/// 1.2e-4, ended five fuzzed scenes with masses 1e-6 to 1e6 in crush errors within their
+/// first two steps).
 const DEPENDENT: f64 = 1024.0;
 
-/// The threshold of [`DEPENDENT`] where the precision's roundings are coarser (`f32`):
-/// there a pivot cannot tell dependence (rounding, ~1e-7) from a mass ratio above 1e4,
-/// and treating a dependent contact as independent costs only a poorly conditioned
-/// solve, while treating a mass ratio as dependence leaves a contact closing (measured:
-/// with 1024 roundings, 1.2e-4, five fuzzed `f32` scenes with masses 1e-6 to 1e6 ended
-/// in crush errors within their first two steps).
-const DEPENDENT_FLOOR: f64 = 1e-11;
+/// The pivot below which a contact is dependent: [`DEPENDENT`] roundings, 2.3e-13.
+const DEPENDENCE_THRESHOLD: f64 = DEPENDENT * f64::EPSILON;
 
-/// The pivot below which a contact is dependent in precision `T`: [`DEPENDENT`]
-/// roundings, at most [`DEPENDENT_FLOOR`].
-fn dependence_threshold<T: Real>() -> T {
-    (T::lit(DEPENDENT) * T::EPSILON).min(T::lit(DEPENDENT_FLOOR))
-}
-
-/// The mass ratio between two bodies in contact beyond which precision `T` cannot hold
-/// their contacts: a ratio `r` leaves pivots of about `1/r` (see [`DEPENDENT`]), which
-/// the solve takes for dependence below [`dependence_threshold`], and which rounding
-/// takes away below `T::EPSILON` (`1/m_light + 1/m_heavy` rounds to `1/m_light`).
-/// Measured with a heavy ball dropped onto a 1 g ball on the floor: held up to 1e4 kg
-/// in `f32` (limit 8.4e6) and 2e9 kg in `f64` (limit 4.4e12), crushed from 3e4 and 5e9 kg.
-pub(crate) fn resolvable_mass_ratio<T: Real>() -> T {
-    T::one() / dependence_threshold::<T>().max(T::EPSILON)
-}
+/// The mass ratio between two bodies in contact beyond which their contacts cannot be
+/// held: a ratio `r` leaves pivots of about `1/r` (see [`DEPENDENT`]), which the solve
+/// takes for dependence below [`DEPENDENCE_THRESHOLD`]: 4.4e12, in `f32` scenes as in
+/// `f64` ones. Measured with a heavy ball dropped onto a 1 g ball on the floor
+/// (`docs/open-scenes/stepped-crush_mass_ratio_f64.toml`): held up to 2e9 kg, crushed
+/// from 5e9 kg, in both precisions. (While the stack solved in the scene's precision,
+/// `f32` held only up to 1e4 kg: `1/m_light + 1/m_heavy` rounded to `1/m_light`.)
+pub(crate) const RESOLVABLE_MASS_RATIO: f64 = 1.0 / DEPENDENCE_THRESHOLD;
 
 /// Scratch of [`Lcp::solve`], kept between calls.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Lcp<T: Real> {
-    scale: Vec<T>,
-    mu: Vec<T>,
-    z: Vec<T>,
-    w: Vec<T>,
+pub(crate) struct Lcp {
+    scale: Vec<f64>,
+    mu: Vec<f64>,
+    z: Vec<f64>,
+    w: Vec<f64>,
     passive: Vec<usize>,
     excluded: Vec<bool>,
-    factor: Vec<T>,
-    forward: Vec<T>,
+    factor: Vec<f64>,
+    forward: Vec<f64>,
     /// The row of the factor whose pivot failed in the last [`Self::solve_passive`].
     dependent: Option<usize>,
     /// The largest problem solved so far (its number of contacts).
     largest: usize,
 }
 
-impl<T: Real> Lcp<T> {
+impl Lcp {
     /// The most contacts of any problem solved so far.
     pub(crate) fn largest(&self) -> usize {
         self.largest
@@ -112,20 +106,26 @@ impl<T: Real> Lcp<T> {
     /// which a closing is rounding). Returns whether every margin ended above
     /// `−tolerance` (dependent contacts with inconsistent margins make it `false`; the
     /// impulses are still the best the independent ones give).
-    pub(crate) fn solve(&mut self, a: &[T], q: &[T], tolerance: T, lambda: &mut [T]) -> bool {
+    pub(crate) fn solve(
+        &mut self,
+        a: &[f64],
+        q: &[f64],
+        tolerance: f64,
+        lambda: &mut [f64],
+    ) -> bool {
         let n = q.len();
         self.largest = self.largest.max(n);
         debug_assert_eq!(a.len(), n * n);
         debug_assert_eq!(lambda.len(), n);
         self.scale.clear();
         self.scale
-            .extend((0..n).map(|i| T::one() / a[i * n + i].max(T::MIN_POSITIVE).sqrt()));
+            .extend((0..n).map(|i| 1.0 / a[i * n + i].max(f64::MIN_POSITIVE).sqrt()));
         self.mu.clear();
-        self.mu.resize(n, T::zero());
+        self.mu.resize(n, 0.0);
         self.z.clear();
-        self.z.resize(n, T::zero());
+        self.z.resize(n, 0.0);
         self.w.clear();
-        self.w.resize(n, T::zero());
+        self.w.resize(n, 0.0);
         self.passive.clear();
         self.excluded.clear();
         self.excluded.resize(n, false);
@@ -164,13 +164,13 @@ impl<T: Real> Lcp<T> {
                     }
                     continue;
                 }
-                if self.passive.iter().all(|&i| self.z[i] > T::zero()) {
+                if self.passive.iter().all(|&i| self.z[i] > 0.0) {
                     for &i in &self.passive {
                         self.mu[i] = self.z[i];
                     }
                     break;
                 }
-                if self.z[t] <= T::zero() && self.mu[t] == T::zero() {
+                if self.z[t] <= 0.0 && self.mu[t] == 0.0 {
                     // Rounding: the contact that entered would not push after all.
                     self.passive.retain(|&i| i != t);
                     self.excluded[t] = true;
@@ -178,9 +178,9 @@ impl<T: Real> Lcp<T> {
                 }
                 // Walk from μ towards z until the first passive entry reaches zero; it
                 // leaves the set (with any other that rounding left at zero).
-                let (mut step, mut blocking) = (T::one(), t);
+                let (mut step, mut blocking) = (1.0, t);
                 for &i in &self.passive {
-                    if self.z[i] <= T::zero() {
+                    if self.z[i] <= 0.0 {
                         let reach = self.mu[i] / (self.mu[i] - self.z[i]);
                         if reach < step {
                             (step, blocking) = (reach, i);
@@ -191,13 +191,13 @@ impl<T: Real> Lcp<T> {
                     let mu = self.mu[i];
                     self.mu[i] = mu + (self.z[i] - mu) * step;
                 }
-                self.mu[blocking] = T::zero();
+                self.mu[blocking] = 0.0;
                 let mu = &mut self.mu;
                 self.passive.retain(|&i| {
-                    if mu[i] > T::zero() {
+                    if mu[i] > 0.0 {
                         return true;
                     }
-                    mu[i] = T::zero();
+                    mu[i] = 0.0;
                     false
                 });
             }
@@ -232,7 +232,7 @@ impl<T: Real> Lcp<T> {
         // The failed row of the factor holds y = L⁻¹ (D A D)_Pt; Lᵀ c = y.
         let mut c = core::mem::take(&mut self.forward);
         c.clear();
-        c.resize(r, T::zero());
+        c.resize(r, 0.0);
         for k in (0..r).rev() {
             let mut sum = self.factor[r * p + k];
             for (l, &cl) in c.iter().enumerate().take(r).skip(k + 1) {
@@ -241,9 +241,9 @@ impl<T: Real> Lcp<T> {
             c[k] = sum / self.factor[k * p + k];
         }
         let mut leaving = None;
-        let mut tau = T::zero();
+        let mut tau = 0.0;
         for (k, &ck) in c.iter().enumerate() {
-            if ck > T::zero() {
+            if ck > 0.0 {
                 let reach = self.mu[self.passive[k]] / ck;
                 if leaving.is_none() || reach < tau {
                     (leaving, tau) = (Some(k), reach);
@@ -256,23 +256,23 @@ impl<T: Real> Lcp<T> {
         };
         for (k, &ck) in c.iter().enumerate() {
             let i = self.passive[k];
-            self.mu[i] = (self.mu[i] - ck * tau).max(T::zero());
+            self.mu[i] = (self.mu[i] - ck * tau).max(0.0);
         }
-        self.mu[self.passive[leaving]] = T::zero();
+        self.mu[self.passive[leaving]] = 0.0;
         self.mu[t] = tau;
         self.forward = c;
         let mu = &self.mu;
-        self.passive.retain(|&i| i == t || mu[i] > T::zero());
+        self.passive.retain(|&i| i == t || mu[i] > 0.0);
         true
     }
 
     /// `z_P = −(D A D)_PP⁻¹ (D q)_P` on the passive set by Cholesky, `z = 0` elsewhere;
     /// `false` if a pivot marks the last passive contact as dependent on the others.
-    fn solve_passive(&mut self, scaled: &impl Fn(&Self, usize, usize) -> T, q: &[T]) -> bool {
+    fn solve_passive(&mut self, scaled: &impl Fn(&Self, usize, usize) -> f64, q: &[f64]) -> bool {
         let p = self.passive.len();
         self.dependent = None;
         self.factor.clear();
-        self.factor.resize(p * p, T::zero());
+        self.factor.resize(p * p, 0.0);
         // L Lᵀ = (D A D)_PP, row by row (lower triangle).
         for r in 0..p {
             for c in 0..=r {
@@ -281,7 +281,7 @@ impl<T: Real> Lcp<T> {
                     sum -= self.factor[r * p + k] * self.factor[c * p + k];
                 }
                 if r == c {
-                    if sum <= dependence_threshold::<T>() {
+                    if sum <= DEPENDENCE_THRESHOLD {
                         self.dependent = Some(r);
                         return false;
                     }
@@ -291,11 +291,11 @@ impl<T: Real> Lcp<T> {
                 }
             }
         }
-        self.z.iter_mut().for_each(|z| *z = T::zero());
+        self.z.iter_mut().for_each(|z| *z = 0.0);
         // Forward: L y = −(D q)_P; backward: Lᵀ z_P = y.
         let mut y = core::mem::take(&mut self.forward);
         y.clear();
-        y.resize(p, T::zero());
+        y.resize(p, 0.0);
         for r in 0..p {
             let i = self.passive[r];
             let mut sum = -q[i] * self.scale[i];

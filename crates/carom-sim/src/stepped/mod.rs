@@ -184,7 +184,7 @@ where
     found: Vec<Event<T, D>>,
     touches: [Vec<Touch<T, D>>; 2],
     /// Scratch of the stacks' complementarity problems (see `stack`).
-    lcp: Lcp<T>,
+    lcp: Lcp,
     /// The bodies held together in the current step (see `stack`).
     groups: Groups,
     /// Each ball's contacts at one instant in the current step (see `wedge`).
@@ -943,7 +943,7 @@ where
 
     /// Why ball `i` could not be held at in-step time `s`, for a crush error: where no box
     /// it touches moves and a ball it touches is heavier or lighter by more than the
-    /// precision resolves (`lcp::resolvable_mass_ratio`), the mass ratio; otherwise that
+    /// contacts' solve resolves (`lcp::RESOLVABLE_MASS_RATIO`), the mass ratio; otherwise that
     /// the ball cannot give way.
     fn crush_reason(&mut self, i: usize, s: T) -> String {
         let cannot_give_way = "it cannot give way (as when a kinematic box presses it into the border or another box from every side it could leave by)".to_string();
@@ -968,25 +968,12 @@ where
                 _ => Some((j, q)),
             });
         self.candidates = candidates;
-        let limit = lcp::resolvable_mass_ratio::<T>();
+        let limit = lcp::RESOLVABLE_MASS_RATIO;
         match widest {
-            Some((j, q)) if q > limit && !pressed_by_a_box => {
-                let precision = if T::EPSILON.to_f64() > f64::EPSILON {
-                    "f32"
-                } else {
-                    "f64"
-                };
-                let advice = if precision == "f32" {
-                    "--precision f64 or masses closer together"
-                } else {
-                    "masses closer together"
-                };
-                format!(
-                    "no box it touches moves, but balls[{j}] touching it differs from it in mass by a factor {:.2e}, beyond the {:.0e} that {precision} resolves: the lighter ball's share of the contacts' impulses is lost to rounding, and they cannot be held (try {advice})",
-                    q.to_f64(),
-                    limit.to_f64()
-                )
-            }
+            Some((j, q)) if q.to_f64() > limit && !pressed_by_a_box => format!(
+                "no box it touches moves, but balls[{j}] touching it differs from it in mass by a factor {:.2e}, beyond the {limit:.1e} that the contacts' solve resolves: the lighter ball's share of the contacts' impulses is lost to rounding, and they cannot be held (try masses closer together)",
+                q.to_f64()
+            ),
             _ => cannot_give_way,
         }
     }

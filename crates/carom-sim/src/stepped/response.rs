@@ -267,7 +267,7 @@ where
     /// Scratch for the broad phase's candidates.
     pub(crate) candidates: &'a mut Vec<u32>,
     /// Scratch of a stack's complementarity problems.
-    pub(crate) lcp: &'a mut Lcp<T>,
+    pub(crate) lcp: &'a mut Lcp,
     /// The bodies held together in this step (see `stack`).
     pub(crate) groups: &'a mut Groups,
     /// The supports the contact's balls touch now: `(ball, touches)` (gathered only

@@ -195,14 +195,15 @@ where
     /// The Delassus matrix of `rows` (row-major, `rows.len()` square):
     /// `A_cd = Σ over shared bodies σ_c σ_d (n_c·n_d/m + (a_c × n_c)·I⁻¹(a_d × n_d))`,
     /// how a unit push along row `d`'s normal changes the approach at row `c`; pushed
-    /// through the centres of mass, the angular term drops.
-    fn delassus(&self, rows: &[usize], push: Push) -> Vec<T> {
+    /// through the centres of mass, the angular term drops. Each body's term is
+    /// computed in `T` and the sum over bodies in `f64` (see [`Wide`]).
+    fn delassus(&self, rows: &[usize], push: Push) -> Vec<f64> {
         let n = rows.len();
-        let mut a = vec![T::zero(); n * n];
+        let mut a = vec![0.0; n * n];
         for (r, &c) in rows.iter().enumerate() {
             for (q, &d) in rows.iter().enumerate().skip(r) {
                 let (nc, nd) = (&self.rows[c].normal, &self.rows[d].normal);
-                let mut sum = T::zero();
+                let mut sum = 0.0;
                 for (ec, sc) in self.ends(c) {
                     for (ed, sd) in self.ends(d).filter(|(e, _)| e.part == ec.part) {
                         let part = &self.parts[ec.part];
@@ -220,7 +221,7 @@ where
                                 )
                             }
                         };
-                        sum += sc * sd * (nc.dot(nd) * part.inverse_mass + angular);
+                        sum += (sc * sd * (nc.dot(nd) * part.inverse_mass + angular)).to_f64();
                     }
                 }
                 a[r * n + q] = sum;
@@ -350,13 +351,38 @@ enum Phase {
     Chord,
 }
 
+/// A linear impulse of a stack's solve, in `f64` whatever the scene's precision.
+///
+/// A light ball pressed by a heavy one into a wall takes two impulses of the heavy
+/// ball's momentum that cancel to its own: in `f32`, with a mass ratio `r` beyond `1/ε`,
+/// the Delassus entry `1/m_light + 1/m_heavy` rounds to `1/m_light`, the problem loses
+/// the heavy ball and the hold leaves it closing (a false crush error: a 100 t ball
+/// dropped onto a 1 g ball on the floor, `docs/open-scenes/`), and the two impulses,
+/// each rounded to `ε` of the heavy ball's momentum, leave the light ball with an error
+/// of `ε r` times its speed. The stack therefore sums the Delassus matrix's terms,
+/// solves the problem ([`Lcp`]) and sums each body's impulses in `f64`, and turns a sum
+/// into a velocity change in `T` only once it is divided by the body's mass. In `f64`
+/// scenes this changes nothing.
+type Wide<const D: usize> = Vector<f64, D>;
+
+/// `v` in `f64`.
+fn wide<T: Real, const D: usize>(v: &Vector<T, D>) -> Wide<D> {
+    v.map(Real::to_f64)
+}
+
+/// `v` back in the precision `T`.
+fn to_precision<T: Real, const D: usize>(v: &Wide<D>) -> Vector<T, D> {
+    v.map(T::lit)
+}
+
 /// The velocity changes of the bodies of a stack under a set of impulses.
 struct Changes<T: Real, const D: usize>
 where
     Const<D>: Space<T, D>,
 {
-    /// Per body: linear impulse and angular impulse about its centre.
-    impulse: Vec<(Vector<T, D>, Angular<T, D>)>,
+    /// Per body: linear impulse (in `f64`, see [`Wide`]) and angular impulse about its
+    /// centre.
+    impulse: Vec<(Wide<D>, Angular<T, D>)>,
 }
 
 impl<T: Real, const D: usize> Changes<T, D>
@@ -365,17 +391,22 @@ where
 {
     fn new(parts: usize) -> Self {
         Self {
-            impulse: vec![(Vector::zeros(), <Const<D> as Space<T, D>>::angular_zero()); parts],
+            impulse: vec![(Wide::zeros(), <Const<D> as Space<T, D>>::angular_zero()); parts],
         }
     }
 
     /// Adds the impulse `p` at end `e` (sign `sign`: `p` acts on the row's ball, `−p` on
     /// the other end).
-    fn add(&mut self, e: &End<T, D>, sign: T, p: &Vector<T, D>) {
-        let p = p * sign;
+    fn add(&mut self, e: &End<T, D>, sign: T, p: &Wide<D>) {
+        let p = p * sign.to_f64();
         let (linear, angular) = &mut self.impulse[e.part];
         *linear += p;
-        *angular += <Const<D> as Space<T, D>>::cross(&e.arm, &p);
+        *angular += <Const<D> as Space<T, D>>::cross(&e.arm, &to_precision(&p));
+    }
+
+    /// The velocity change of body `part`'s centre under the linear impulse `linear`.
+    fn linear_change(part: &Part<T, D>, linear: &Wide<D>) -> Vector<T, D> {
+        to_precision(&(linear * part.inverse_mass.to_f64()))
     }
 
     /// The velocity change of the point at end `e`.
@@ -383,7 +414,7 @@ where
         let part = &stack.parts[e.part];
         let (linear, angular) = &self.impulse[e.part];
         let dw = <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
-        linear * part.inverse_mass + <Const<D> as Space<T, D>>::angular_cross(&dw, &e.arm)
+        Self::linear_change(part, linear) + <Const<D> as Space<T, D>>::angular_cross(&dw, &e.arm)
     }
 }
 
@@ -487,7 +518,7 @@ where
         let zero = vec![T::zero(); touching.len()];
         let impacts = self.impulses(&stack, &touching, &start, &start_approach, &zero);
         let mut pushed = vec![false; stack.rows.len()];
-        if impacts.iter().any(|p| *p != Vector::<T, D>::zeros()) {
+        if impacts.iter().any(|p| *p != Wide::<D>::zeros()) {
             let changes = Self::changes(&stack, &touching, &impacts, &mut pushed);
             self.strike(&stack, &changes);
         }
@@ -531,12 +562,15 @@ where
             for (e, _) in stack.ends(c) {
                 stop.impulse[e.part] = match stack.parts[e.part].side {
                     Side::Ball(i) => (
-                        -self.balls.seg_v[i] * self.balls.mass[i],
+                        -wide(&self.balls.seg_v[i]) * self.balls.mass[i].to_f64(),
                         <Const<D> as Space<T, D>>::angular_zero(),
                     ),
                     Side::Cluster(k) => {
                         let start = &self.clusters.list[k].start;
-                        (-start.velocity() * start.mass(), -start.angular_momentum())
+                        (
+                            -wide(&start.velocity()) * start.mass().to_f64(),
+                            -start.angular_momentum(),
+                        )
                     }
                 };
             }
@@ -669,7 +703,7 @@ where
         targets: &[T],
         pushed: &mut [bool],
     ) {
-        let mut total = vec![Vector::<T, D>::zeros(); held.len()];
+        let mut total = vec![Wide::<D>::zeros(); held.len()];
         let mut unused = vec![false; stack.rows.len()];
         for _ in 0..HOLD_ROUNDS {
             let mut chords: Vec<_> = (0..stack.rows.len())
@@ -729,17 +763,17 @@ where
             return false;
         }
         let a = stack.delassus(held, Push::ThroughCentres);
-        let q: Vec<T> = excess.iter().map(|&u| -u).collect();
-        let mut lambda = vec![T::zero(); held.len()];
+        let q: Vec<f64> = excess.iter().map(|&u| -u.to_f64()).collect();
+        let mut lambda = vec![0.0; held.len()];
         self.lcp
-            .solve(&a, &q, self.tolerance(stack, held), &mut lambda);
+            .solve(&a, &q, self.tolerance(stack, held).to_f64(), &mut lambda);
         for (&c, &l) in held.iter().zip(&lambda) {
-            if l <= T::zero() {
+            if l <= 0.0 {
                 continue;
             }
-            let p = -stack.rows[c].normal * l;
+            let p = -wide(&stack.rows[c].normal) * l;
             for (e, sign) in stack.ends(c) {
-                changes.impulse[e.part].0 += p * sign;
+                changes.impulse[e.part].0 += p * sign.to_f64();
             }
             pushed[c] = true;
         }
@@ -1129,16 +1163,16 @@ where
         relative: &[Vector<T, D>],
         approach: &[T],
         margins: &[T],
-    ) -> Vec<Vector<T, D>> {
+    ) -> Vec<Wide<D>> {
         let n = rows.len();
         if n == 0 {
             return Vec::new();
         }
         let a = stack.delassus(rows, Push::AtContacts);
         let approach: Vec<T> = rows.iter().map(|&c| approach[c]).collect();
-        let tolerance = self.tolerance(stack, rows);
-        let mut lambda = vec![T::zero(); n];
-        let mut tangential = vec![Vector::<T, D>::zeros(); n];
+        let tolerance = self.tolerance(stack, rows).to_f64();
+        let mut lambda = vec![0.0; n];
+        let mut tangential = vec![Wide::<D>::zeros(); n];
         let friction = self.rules.friction;
         for _ in 0..FRICTION_ROUNDS {
             // Normal impulses against the approach the tangential ones leave.
@@ -1148,13 +1182,13 @@ where
                     changes.add(&e, sign, &tangential[k]);
                 }
             }
-            let q: Vec<T> = (rows.iter().enumerate())
+            let q: Vec<f64> = (rows.iter().enumerate())
                 .map(|(k, &c)| {
                     let row = &stack.rows[c];
                     let moved = stack.ends(c).fold(Vector::zeros(), |sum, (e, sign)| {
                         sum + changes.at(stack, &e) * sign
                     });
-                    margins[k] - approach[k] - moved.dot(&row.normal)
+                    (margins[k] - approach[k] - moved.dot(&row.normal)).to_f64()
                 })
                 .collect();
             self.lcp.solve(&a, &q, tolerance, &mut lambda);
@@ -1167,7 +1201,7 @@ where
             let mut scale = T::zero();
             let mut changes = Changes::new(stack.parts.len());
             for (l, &d) in rows.iter().enumerate() {
-                let p = tangential[l] - stack.rows[d].normal * lambda[l];
+                let p = tangential[l] - wide(&stack.rows[d].normal) * lambda[l];
                 for (e, sign) in stack.ends(d) {
                     changes.add(&e, sign, &p);
                 }
@@ -1188,8 +1222,8 @@ where
                 let k_t = stack.ends(c).fold(T::zero(), |sum, (e, _)| {
                     sum + stiffness(&stack.parts[e.part], &e, &t)
                 });
-                let wanted = tangential[k] - t * (speed / k_t);
-                let bound = friction * lambda[k];
+                let wanted = tangential[k] - wide(&t) * (speed / k_t).to_f64();
+                let bound = friction.to_f64() * lambda[k];
                 let clamped = if wanted.norm() > bound {
                     wanted * (bound / wanted.norm())
                 } else {
@@ -1200,14 +1234,14 @@ where
                 for (e, sign) in stack.ends(c) {
                     changes.add(&e, sign, &step);
                 }
-                change = change.max(step.norm() * k_t);
+                change = change.max(T::lit(step.norm()) * k_t);
             }
             if change <= T::lit(1e-12) * scale {
                 break;
             }
         }
         (rows.iter().zip(lambda.iter().zip(&tangential)))
-            .map(|(&c, (&l, t))| t - stack.rows[c].normal * l)
+            .map(|(&c, (&l, t))| t - wide(&stack.rows[c].normal) * l)
             .collect()
     }
 
@@ -1215,7 +1249,7 @@ where
     fn changes(
         stack: &Stack<T, D>,
         rows: &[usize],
-        impulses: &[Vector<T, D>],
+        impulses: &[Wide<D>],
         pushed: &mut [bool],
     ) -> Changes<T, D> {
         let mut changes = Changes::new(stack.parts.len());
@@ -1223,7 +1257,7 @@ where
             for (e, sign) in stack.ends(c) {
                 changes.add(&e, sign, p);
             }
-            if p.dot(&stack.rows[c].normal) < T::zero() {
+            if p.dot(&wide(&stack.rows[c].normal)) < 0.0 {
                 pushed[c] = true;
             }
         }
@@ -1239,13 +1273,13 @@ where
                     let dw =
                         <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
                     self.balls
-                        .nudge(i, self.h, &(linear * part.inverse_mass), &dw);
+                        .nudge(i, self.h, &Changes::linear_change(part, linear), &dw);
                     self.rest
                         .restart(i, self.balls.seg_t[i], self.balls.chord[i]);
                 }
                 Side::Cluster(c) => {
                     let rigid = Motion {
-                        velocity: linear * part.inverse_mass,
+                        velocity: Changes::linear_change(part, linear),
                         momentum: *angular,
                     }
                     .added(&self.clusters.list[c].start, T::one());
@@ -1277,7 +1311,7 @@ where
         let w = T::lit(self.stepper.integrator().chord_weight());
         let flight = self.flight();
         for (part, (linear, angular)) in stack.parts.iter().zip(&changes.impulse) {
-            let dv = linear * part.inverse_mass;
+            let dv = Changes::linear_change(part, linear);
             match (part.side, part.free) {
                 (Side::Ball(i), Free::Ball([seg_v, chord, vel], [seg_w, spin])) => {
                     let (start_share, end_share) =
