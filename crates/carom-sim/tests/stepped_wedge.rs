@@ -574,6 +574,35 @@ fn a_light_ball_struck_into_a_wall_at_a_slant_by_a_heavy_ball_is_not_taken_for_c
     }
 }
 
+/// The fourth campaign's s29 in `f32` (32 balls, two boxes, drag): a 1.4 mg ball in the
+/// lower right corner is wedged at a slant by a ball 1.8e8 times heavier. Its three
+/// rows on two degrees of freedom are independent only through the heavy ball's `1/m`,
+/// a part in 1.8e8 of the light ball's. The Delassus matrix was summed in `f64` but
+/// each body's term `n_c·n_d/m` was still rounded in `f32`, to 6e-8 of the light
+/// ball's, which hid that part: the solve pushed along the wrong combination and left
+/// the light ball closing on the right wall at 363 m/s, hold after hold, a false crush
+/// error at 0.0427 s with the exact integrator. The linear terms are now computed in
+/// `f64` (`stack::Wide`). The exact integrator (the scene's drag allows it alone at this
+/// step), 0.1 s: no error, no ball outside the border or overlapping beyond 1e-6 m.
+const F32_LIGHT_BALL_WEDGED_IN_A_CORNER: &str =
+    include_str!("scenes/f32_light_ball_wedged_in_a_corner_by_a_heavy_ball.toml");
+
+#[test]
+fn a_light_ball_wedged_in_a_corner_at_a_slant_by_a_far_heavier_ball_is_held_in_f32() {
+    let s = scene_2d(F32_LIGHT_BALL_WEDGED_IN_A_CORNER)
+        .cast::<f32>()
+        .unwrap();
+    let mut sim = stepped(&s, Integrator::Exact, 0.01);
+    sim.advance_to(0.1, &mut ())
+        .unwrap_or_else(|e| panic!("f32, exact: {e}"));
+    let st = states(&sim);
+    let (outside, overlap) = (outside_border(&s, &st), deepest_overlap(&s, &st));
+    assert!(
+        outside <= 1e-6 && overlap <= 1e-6,
+        "{outside:e} m outside, overlap {overlap:e} m"
+    );
+}
+
 /// A fuzzed scene in `f32` (the third campaign's s46, 30 balls 1,000 m from the origin,
 /// periodic): a 52 mg ball is squeezed between a static box and an 11,423 kg ball coming
 /// down at 3.4e4 m/s, a mass ratio of 2e8, beyond what `f32` resolves (1/ε = 8.4e6), and

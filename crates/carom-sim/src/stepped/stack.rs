@@ -221,7 +221,10 @@ where
                                 )
                             }
                         };
-                        sum += (sc * sd * (nc.dot(nd) * part.inverse_mass + angular)).to_f64();
+                        // The linear term in `f64` too: rounded in `f32`, `n_c·n_d/m`
+                        // of the light ball hid the heavy ball's part (see `Wide`).
+                        let linear = wide(nc).dot(&wide(nd)) * part.inverse_mass.to_f64();
+                        sum += (sc * sd).to_f64() * (linear + angular.to_f64());
                     }
                 }
                 a[r * n + q] = sum;
@@ -359,10 +362,13 @@ enum Phase {
 /// the heavy ball and the hold leaves it closing (a false crush error: a 100 t ball
 /// dropped onto a 1 g ball on the floor, `docs/open-scenes/`), and the two impulses,
 /// each rounded to `ε` of the heavy ball's momentum, leave the light ball with an error
-/// of `ε r` times its speed. The stack therefore sums the Delassus matrix's terms,
-/// solves the problem ([`Lcp`]) and sums each body's impulses in `f64`, and turns a sum
-/// into a velocity change in `T` only once it is divided by the body's mass. In `f64`
-/// scenes this changes nothing.
+/// of `ε r` times its speed. The stack therefore computes the Delassus matrix's linear
+/// terms (`n_c·n_d/m`, from the rows' normals as they are) and sums them, solves the
+/// problem ([`Lcp`]) and sums each body's impulses in `f64`, and turns a sum into a
+/// velocity change in `T` only once it is divided by the body's mass. (Rounded to `f32`,
+/// the light ball's `n_c·n_d/m` of three rows on its two degrees of freedom hid the
+/// heavy ball's part, a 1.8e8th of it, and the solve left the light ball closing on a
+/// wall at 363 m/s: the fourth campaign's s29.) In `f64` scenes this changes nothing.
 type Wide<const D: usize> = Vector<f64, D>;
 
 /// `v` in `f64`.
