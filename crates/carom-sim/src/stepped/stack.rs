@@ -195,8 +195,8 @@ where
     /// The Delassus matrix of `rows` (row-major, `rows.len()` square):
     /// `A_cd = Σ over shared bodies σ_c σ_d (n_c·n_d/m + (a_c × n_c)·I⁻¹(a_d × n_d))`,
     /// how a unit push along row `d`'s normal changes the approach at row `c`; pushed
-    /// through the centres of mass, the angular term drops. Each body's term is
-    /// computed in `T` and the sum over bodies in `f64` (see [`Wide`]).
+    /// through the centres of mass, the angular term drops. The linear term and the sum
+    /// over bodies are computed in `f64`, the angular term in `T` (see [`Wide`]).
     fn delassus(&self, rows: &[usize], push: Push) -> Vec<f64> {
         let n = rows.len();
         let mut a = vec![0.0; n * n];
