@@ -229,8 +229,13 @@ where
     /// How a run is cut into `advance_to` calls does not change its trajectory.
     ///
     /// # Errors
-    /// A [`SimError`] if the engine cannot continue exactly (the state is left at the
-    /// time of the failure).
+    /// A [`SimError`] if the engine cannot go on; the run is then over. Only a
+    /// [`SimErrorKind::SustainedContact`] leaves a state to go on from (every ball at the
+    /// failure's time, nothing overlapping: what
+    /// [`EventThenStepped`](crate::EventThenStepped) continues). After any other error
+    /// read the states for diagnosis only: the time-stepped engine, for one, leaves the
+    /// failing step half done (its clock at the step's start, balls between their
+    /// integrated ends and the failure's instant, possibly overlapping).
     fn advance_to(&mut self, target: T, observer: &mut dyn Observer<T>) -> Result<(), SimError>;
 
     /// Writes the state of every ball at the current time into `out`.
