@@ -15,14 +15,9 @@
 //! with one seed and passing the first one's `results.tsv` to the second as `--compare`,
 //! which lists every run whose outcome or samples (a hash of every sample's bits) differ.
 //!
-//! **The scenes** mix what the stepped engine must survive (docs/stepped.md, "Fuzzing"):
-//! 2D (three in four) and 3D; 2 to 40 balls; reflecting or periodic borders; static and
-//! moving boxes, rotated or not; coordinates near 0, 1e3 or −5e4 m; half the scenes on a
-//! grid `f32` holds exactly, with balls touching each other and the walls; masses over
-//! twelve decades; speeds from rest to 1e6 m/s; restitution 0 to 1 (per-ball overrides,
-//! sticking); friction, drag and gravity. Each is written to `DIR/sNN.toml`, so one run
-//! is reproduced with `carom run DIR/sNN.toml --engine stepped --until 2 --dt 0.01
-//! --integrator ... --precision ...`.
+//! **The scenes** are `carom_sim::scenes::fuzz::scene_text`'s (its docs list what they
+//! mix). Each is written to `DIR/sNN.toml`, so one run is reproduced with `carom run
+//! DIR/sNN.toml --engine stepped --until 2 --dt 0.01 --integrator ... --precision ...`.
 //!
 //! **The runs.** Every scene with each of the five integrators in `f64`, and with
 //! semi-implicit Euler and the exact integrator in `f32`: 7 runs per scene. A run ends
@@ -32,13 +27,11 @@
 //! `refused` (another planning error), `crush`, `spin`, `moves-at`, `overflow` or `error`
 //! (the engine's errors, sorted by their messages), `timeout` or `panic`.
 //!
-//! **The checks**, at every sample up to the end (the last before an error): every coordinate finite (`nan`); how far
-//! a ball reaches out of a reflecting border, into another ball (minimum image in a
-//! periodic border) or into a box at its place at that time; and for scenes without a
-//! moving box, how far the energy rose above its start, beyond what a first-order scheme's
-//! truncation under gravity allows (`Σm |g|² dt t`: explicit Euler gains `m g² dt²/2`
-//! per step in free flight). The largest excursions are given in metres and in units of
-//! the precision's resolution at the scene's largest coordinate (`ε · max|x|`).
+//! **The checks** are `carom_sim::scenes::fuzz::Invariants`', at every sample up to the
+//! end (the last before an error: the state after one is for diagnosis only): finite
+//! states, overlaps of balls and boxes, reach out of the border, energy rise. The largest
+//! excursions are given in metres and in units of the precision's resolution at the
+//! scene's largest coordinate (`ε · max|x|`).
 //!
 //! `DIR/results.tsv` holds one line per run; the summary (counts by outcome and
 //! precision, the worst excursions, the energy rises) goes to standard output.
@@ -50,12 +43,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, mpsc};
 use std::time::{Duration, Instant};
 
-use carom_broad::scenes::SplitMix64;
 use carom_integrate::Integrator;
-use carom_math::{Real, Space, Vector};
-use carom_sim::observe::{energy, state_hash};
+use carom_math::{Real, Space};
+use carom_sim::observe::state_hash;
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};
 use carom_sim::scene::{LoadedScene, Scene, parse_scene};
+use carom_sim::scenes::fuzz::{Invariants, scene_text};
 use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Simulation};
 use carom_toi::Direction;
@@ -170,7 +163,7 @@ fn main() {
         std::process::exit(2);
     });
     let scenes: Vec<String> = (0..settings.scenes)
-        .map(|k| generate(settings.seed, k))
+        .map(|k| scene_text(settings.seed, k))
         .collect();
     for (k, text) in scenes.iter().enumerate() {
         let path = settings.out.join(format!("s{k:02}.toml"));
@@ -311,419 +304,39 @@ where
         Ok(sim) => sim,
         Err(e) => return refusal("refused", &e.to_string()),
     };
-    let check = Checks::new(scene);
-    let mut outcome = Outcome {
-        kind: "completed".into(),
-        resolution: check.resolution,
-        ..Outcome::default()
-    };
     let mut states = BallStates::default();
     sim.states(&mut states);
-    let start_energy = energy(scene, &states).to_f64();
+    let invariants = Invariants::new(scene, &states);
+    let mut outcome = Outcome {
+        kind: "completed".into(),
+        resolution: invariants.resolution(),
+        ..Outcome::default()
+    };
     let samples = (settings.until / settings.every).round() as u64;
     for k in 0..=samples {
         let t = (k as f64 * settings.every).min(settings.until);
         if let Err(e) = sim.advance_to(T::lit(t), &mut ()) {
+            // The state after an error is for diagnosis only (`Simulation::advance_to`):
+            // the checks stop at the last sample before it.
             outcome.kind = error_kind(&e.message).into();
             outcome.end = e.time;
             outcome.message = e.message;
-            // The state after an error is for diagnosis only (`Simulation::advance_to`):
-            // the checks stop at the last sample before it.
             break;
         }
         outcome.end = t;
         sim.states(&mut states);
-        check.sample(scene, &states, t, start_energy, settings, &mut outcome);
-    }
-    outcome
-}
-
-/// What the checks need of a scene, worked out once.
-struct Checks {
-    resolution: f64,
-    mass: f64,
-    gravity_squared: f64,
-    energy_scale: f64,
-    energy_checked: bool,
-}
-
-impl Checks {
-    fn new<T: Real, const D: usize>(scene: &Scene<T, D>) -> Self
-    where
-        Const<D>: Space<T, D>,
-    {
-        let mut largest = 1.0_f64;
-        for b in &scene.balls {
-            largest = b.pos.iter().fold(largest, |m, x| m.max(x.to_f64().abs()));
-        }
-        if let Some(border) = &scene.world.border {
-            let (lo, hi) = (border.border.min(), border.border.max());
-            largest = lo
-                .iter()
-                .chain(hi.iter())
-                .fold(largest, |m, x| m.max(x.to_f64().abs()));
-        }
-        let mass: f64 = scene.balls.iter().map(|b| b.mass.to_f64()).sum();
-        let speed_energy: f64 = (scene.balls.iter())
-            .map(|b| 0.5 * b.mass.to_f64() * b.vel.norm_squared().to_f64())
-            .sum();
-        let g = scene.world.gravity.norm().to_f64();
-        let extent = scene.world.border.as_ref().map_or(1.0, |b| {
-            b.border
-                .extents()
-                .iter()
-                .fold(0.0_f64, |m, x| m.max(x.to_f64()))
-        });
-        Checks {
-            resolution: T::EPSILON.to_f64() * largest,
-            mass,
-            gravity_squared: g * g,
-            // Kinetic energy plus the potential energy over the border's height: the scale
-            // a relative rise is measured against (the start's total may be near zero).
-            energy_scale: (speed_energy + mass * g * extent).max(f64::MIN_POSITIVE),
-            energy_checked: scene
-                .boxes
-                .iter()
-                .all(|b| b.vel.norm_squared() == T::zero()),
-        }
-    }
-
-    /// Checks the states at time `t` and keeps the largest excursions in `outcome`.
-    fn sample<T: Real, const D: usize>(
-        &self,
-        scene: &Scene<T, D>,
-        states: &BallStates<T, D>,
-        t: f64,
-        start_energy: f64,
-        settings: &Settings,
-        outcome: &mut Outcome,
-    ) where
-        Const<D>: Space<T, D>,
-    {
-        outcome.hash = outcome.hash.wrapping_mul(0x0100_0000_01b3) ^ state_hash(states);
-        let wide = |v: &Vector<T, D>| v.map(T::to_f64);
-        if states
-            .pos
-            .iter()
-            .chain(&states.vel)
-            .any(|v| v.iter().any(|x| !x.finite()))
-        {
-            outcome.nan = true;
-            return;
-        }
-        let border = scene.world.border.as_ref();
-        let periodic = border
-            .filter(|b| b.periodic)
-            .map(|b| wide(&b.border.extents()));
-        let image = |mut d: Vector<f64, D>| {
-            if let Some(l) = &periodic {
-                for (x, l) in d.iter_mut().zip(l.iter()) {
-                    *x -= l * (*x / l).round();
-                }
-            }
-            d
-        };
-        let pos: Vec<Vector<f64, D>> = states.pos.iter().map(wide).collect();
-        let before = outcome.worst();
-        let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius.to_f64()).collect();
-        for i in 0..pos.len() {
-            for j in i + 1..pos.len() {
-                let d = image(pos[j] - pos[i]).norm();
-                outcome.ball_overlap = outcome.ball_overlap.max(radius[i] + radius[j] - d);
-            }
-            if let Some(b) = border.filter(|b| !b.periodic) {
-                let (lo, hi) = (wide(&b.border.min()), wide(&b.border.max()));
-                for k in 0..D {
-                    let out = (lo[k] - (pos[i][k] - radius[i])).max(pos[i][k] + radius[i] - hi[k]);
-                    outcome.border_out = outcome.border_out.max(out);
-                }
-            }
-            for b in &scene.boxes {
-                let centre = wide(&b.shape.center()) + wide(&b.vel) * t;
-                let offset = image(pos[i] - centre);
-                let local = Vector::<f64, D>::from_fn(|k, _| offset.dot(&wide(&b.shape.axis(k))));
-                let half = wide(&b.shape.half_extents());
-                outcome.box_overlap = outcome
-                    .box_overlap
-                    .max(radius[i] - box_distance(&local, &half));
-            }
-        }
-        if outcome.worst() > before {
+        outcome.hash = outcome.hash.wrapping_mul(0x0100_0000_01b3) ^ state_hash(&states);
+        let sample = invariants.sample(scene, &states, t, settings.dt);
+        outcome.nan |= !sample.finite;
+        if sample.worst() > outcome.worst() {
             outcome.worst_at = t;
         }
-        if self.energy_checked {
-            let allowed = self.mass * self.gravity_squared * settings.dt * t;
-            let rise = energy(scene, states).to_f64() - start_energy - allowed;
-            outcome.energy_rise = outcome.energy_rise.max(rise / self.energy_scale);
-        }
+        outcome.ball_overlap = outcome.ball_overlap.max(sample.ball_overlap);
+        outcome.box_overlap = outcome.box_overlap.max(sample.box_overlap);
+        outcome.border_out = outcome.border_out.max(sample.border_out);
+        outcome.energy_rise = outcome.energy_rise.max(sample.energy_rise.unwrap_or(0.0));
     }
-}
-
-/// The signed distance from a point in a box's frame to the box of half extents `half`
-/// (negative inside: minus the distance to the nearest face).
-fn box_distance<const D: usize>(local: &Vector<f64, D>, half: &Vector<f64, D>) -> f64 {
-    let outside = local.zip_map(half, |x, h| (x.abs() - h).max(0.0)).norm();
-    if outside > 0.0 {
-        return outside;
-    }
-    -local.zip_map(half, |x, h| h - x.abs()).min()
-}
-
-/// Scene `k` of the campaign `seed`, as scene-file text: retried with the next draw of
-/// its own stream until it is a valid scene in `f64` (the generator places bodies apart
-/// to its own tolerance; the loader decides).
-fn generate(seed: u64, k: usize) -> String {
-    let mut rng = SplitMix64::new(seed ^ (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    loop {
-        let text = if rng.next_f64() < 0.75 {
-            draw::<2>(&mut rng, k)
-        } else {
-            draw::<3>(&mut rng, k)
-        };
-        if parse_scene(&text).is_ok() {
-            return text;
-        }
-    }
-}
-
-/// A float as the scene file writes it (Rust's shortest round-trip form, with an exponent
-/// where it is shorter: TOML reads both).
-fn num(x: f64) -> String {
-    format!("{x:?}")
-}
-
-fn vector<const D: usize>(v: &[f64; D]) -> String {
-    let parts: Vec<String> = v.iter().map(|&x| num(x)).collect();
-    format!("[{}]", parts.join(", "))
-}
-
-/// Log-uniform in `[lo, hi]`.
-fn log_uniform(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
-    (rng.range(lo.ln(), hi.ln())).exp()
-}
-
-/// Where a scene's bodies may go: its border and the grid it snaps to.
-struct Frame<const D: usize> {
-    origin: f64,
-    half: f64,
-    periodic: bool,
-    /// The unit coordinates are rounded to (`None`: not rounded).
-    grid: Option<f64>,
-}
-
-impl<const D: usize> Frame<D> {
-    fn snap(&self, x: f64) -> f64 {
-        self.grid.map_or(x, |q| (x / q).round() * q)
-    }
-
-    /// A point whose ball of `margin` fits inside the border, snapped to the grid.
-    fn point(&self, rng: &mut SplitMix64, margin: f64) -> [f64; D] {
-        std::array::from_fn(|_| {
-            self.snap(self.origin + rng.range(-1.0, 1.0) * (self.half - margin).max(0.0))
-        })
-    }
-
-    /// The distance between two points (the minimum image in a periodic border).
-    fn distance(&self, p: &[f64; D], q: &[f64; D]) -> f64 {
-        let period = 2.0 * self.half;
-        (0..D)
-            .map(|a| {
-                let d = p[a] - q[a];
-                let d = if self.periodic {
-                    d - period * (d / period).round()
-                } else {
-                    d
-                };
-                d * d
-            })
-            .sum::<f64>()
-            .sqrt()
-    }
-}
-
-/// One draw of a `D`-dimensional scene.
-fn draw<const D: usize>(rng: &mut SplitMix64, k: usize) -> String {
-    let origin = match rng.next_f64() {
-        u if u < 0.5 => 0.0,
-        u if u < 0.8 => 1e3,
-        _ => -5e4,
-    };
-    // Half the scenes on a grid f32 holds exactly at their coordinates (its unit is at
-    // least 4 f32 ulps there), so that contacts touching in the file touch in f32 too.
-    let grid = (rng.next_f64() < 0.5).then_some(if origin == -5e4 {
-        0.015_625
-    } else {
-        1.0 / 1024.0
-    });
-    let frame = Frame::<D> {
-        origin,
-        half: [1.0, 2.0, 4.0][(rng.next_f64() * 3.0) as usize],
-        periodic: rng.next_f64() < 0.2,
-        grid,
-    };
-    let mut text = world(rng, k, &frame);
-    let boxes = boxes(rng, &frame, &mut text);
-    balls(rng, &frame, &boxes, &mut text);
-    text
-}
-
-/// The scene's header and `[world]` tables.
-fn world<const D: usize>(rng: &mut SplitMix64, k: usize, frame: &Frame<D>) -> String {
-    let mut text = String::new();
-    let _ = writeln!(
-        text,
-        "dim = {D}\nname = \"stepped-fuzz-s{k:02}\"\n\n[world]"
-    );
-    let restitution = match rng.next_f64() {
-        u if u < 0.3 => 1.0,
-        u if u < 0.5 => 0.0,
-        _ => frame.snap(rng.next_f64()),
-    };
-    let _ = writeln!(text, "restitution = {}", num(restitution));
-    if restitution == 0.0 && rng.next_f64() < 0.5 {
-        let _ = writeln!(text, "inelastic = \"stick\"");
-    }
-    if rng.next_f64() < 0.25 {
-        let _ = writeln!(text, "friction = {}", num(frame.snap(rng.next_f64())));
-    }
-    if rng.next_f64() < 0.2 {
-        let _ = writeln!(text, "drag = {}", num(log_uniform(rng, 1e-3, 1.0)));
-    }
-    if rng.next_f64() < 0.4 {
-        let mut g = [0.0; D];
-        g[D - 1] = -9.81;
-        let _ = writeln!(text, "gravity = {}", vector(&g));
-    }
-    let _ = writeln!(
-        text,
-        "\n[world.border]\nmin = {}\nmax = {}\nrestitution = {}\nperiodic = {}",
-        vector(&[frame.origin - frame.half; D]),
-        vector(&[frame.origin + frame.half; D]),
-        num([1.0, 0.0, 0.5][(rng.next_f64() * 3.0) as usize]),
-        frame.periodic
-    );
-    text
-}
-
-/// Up to three boxes, rotated or not, static or moving, inside the border; returns each
-/// one's centre and the radius of its bounding ball.
-fn boxes<const D: usize>(
-    rng: &mut SplitMix64,
-    frame: &Frame<D>,
-    text: &mut String,
-) -> Vec<([f64; D], f64)> {
-    let count = if rng.next_f64() < 0.5 {
-        0
-    } else {
-        1 + (rng.next_f64() * 3.0) as usize
-    };
-    (0..count)
-        .map(|_| {
-            let extents: [f64; D] =
-                std::array::from_fn(|_| frame.snap(frame.half * log_uniform(rng, 0.05, 0.3)));
-            let reach = extents.iter().map(|e| e * e).sum::<f64>().sqrt();
-            let centre = frame.point(rng, reach);
-            let vel: [f64; D] = if rng.next_f64() < 0.5 {
-                let speed = log_uniform(rng, 0.1, 100.0);
-                rng.direction::<D>().map(|x| x * speed)
-            } else {
-                [0.0; D]
-            };
-            let _ = writeln!(
-                text,
-                "\n[[boxes]]\ncenter = {}\nhalf_extents = {}\nvel = {}\nrestitution = {}",
-                vector(&centre),
-                vector(&extents),
-                vector(&vel),
-                num(frame.snap(rng.next_f64()))
-            );
-            if rng.next_f64() < 0.5 {
-                let angle = rng.range(-3.0, 3.0);
-                if D == 2 {
-                    let _ = writeln!(text, "angle = {}", num(angle));
-                } else {
-                    let axis = rng.direction::<3>().map(|x| x * angle);
-                    let _ = writeln!(text, "axis_angle = {}", vector(&axis));
-                }
-            }
-            (centre, reach)
-        })
-        .collect()
-}
-
-/// 2 to 40 balls (few more often than many), apart from each other and the boxes; a
-/// quarter of them placed touching another ball along an axis, a tenth touching a wall.
-fn balls<const D: usize>(
-    rng: &mut SplitMix64,
-    frame: &Frame<D>,
-    boxes: &[([f64; D], f64)],
-    text: &mut String,
-) {
-    let (lo, hi) = (frame.origin - frame.half, frame.origin + frame.half);
-    let n = 2 + (38.0 * rng.next_f64().powi(2)) as usize;
-    let mut placed: Vec<([f64; D], f64)> = Vec::new();
-    for _ in 0..n {
-        let radius = frame
-            .snap(frame.half * log_uniform(rng, 5e-3, 0.12))
-            .max(frame.grid.unwrap_or(0.0) * 4.0);
-        for _attempt in 0..100 {
-            let pos: [f64; D] = match rng.next_f64() {
-                u if u < 0.25 && !placed.is_empty() => {
-                    let (other, r) = placed[(rng.next_f64() * placed.len() as f64) as usize];
-                    let axis = (rng.next_f64() * D as f64) as usize;
-                    let sign = if rng.next_f64() < 0.5 { -1.0 } else { 1.0 };
-                    let mut p = other;
-                    p[axis] += sign * (r + radius);
-                    p
-                }
-                u if u < 0.35 && !frame.periodic => {
-                    let mut p = frame.point(rng, radius);
-                    let axis = (rng.next_f64() * D as f64) as usize;
-                    p[axis] = if rng.next_f64() < 0.5 {
-                        lo + radius
-                    } else {
-                        hi - radius
-                    };
-                    p
-                }
-                _ => frame.point(rng, radius),
-            };
-            let inside = frame.periodic || pos.iter().all(|x| x - radius >= lo && x + radius <= hi);
-            let apart = (placed.iter())
-                .all(|(q, r)| frame.distance(&pos, q) >= (r + radius) * (1.0 - 1e-15));
-            let off_boxes =
-                (boxes.iter()).all(|(c, reach)| frame.distance(&pos, c) > reach + radius);
-            if inside && apart && off_boxes {
-                placed.push((pos, radius));
-                break;
-            }
-        }
-    }
-    for (pos, radius) in &placed {
-        let mass = if rng.next_f64() < 0.5 {
-            log_uniform(rng, 1e-6, 1e6)
-        } else {
-            log_uniform(rng, 0.1, 10.0)
-        };
-        let speed = match rng.next_f64() {
-            u if u < 0.1 => 0.0,
-            u if u < 0.2 => log_uniform(rng, 1e3, 1e6),
-            u if u < 0.5 => log_uniform(rng, 1.0, 100.0),
-            _ => log_uniform(rng, 1e-2, 3.0),
-        };
-        let vel = rng.direction::<D>().map(|x| x * speed);
-        let _ = writeln!(
-            text,
-            "\n[[balls]]\npos = {}\nvel = {}\nradius = {}\nmass = {}",
-            vector(pos),
-            vector(&vel),
-            num(*radius),
-            num(mass)
-        );
-        if rng.next_f64() < 0.2 {
-            let _ = writeln!(text, "restitution = {}", num(frame.snap(rng.next_f64())));
-        }
-    }
+    outcome
 }
 
 /// One line per run: scene, precision, integrator, outcome, end time, the excursions and

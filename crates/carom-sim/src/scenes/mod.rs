@@ -6,9 +6,12 @@
 //!   fraction, with random velocities and zero total momentum — the throughput scenes.
 //! * [`classic`]: small textbook set-ups with closed-form answers (head-on and oblique
 //!   collisions, Newton's cradle, a dropped ball).
+//! * [`fuzz`]: random scenes of every kind the scene format allows, drawn from a seed,
+//!   and the invariants a run of one must keep (robustness campaigns).
 
 pub mod classic;
 pub mod collision_lab;
+pub mod fuzz;
 pub mod gas;
 
 /// The deterministic random generator of every shared scene: carom-broad's SplitMix64,

@@ -1,0 +1,430 @@
+//! Reproducible random scenes for robustness campaigns ("fuzzing"), and the invariants
+//! every run of one must keep.
+//!
+//! [`scene_text`] draws scene `k` of a campaign from its seed as scene-file text (so a
+//! scene that fails can be saved and rerun with `carom run`): 2D (three in four) and 3D;
+//! 2 to 40 balls; reflecting or periodic borders; static and moving boxes, rotated or
+//! not; coordinates near 0, 1e3 or −5e4 m; half the scenes on a grid `f32` holds exactly,
+//! with balls touching each other and the walls; masses over twelve decades; speeds from
+//! rest to 1e6 m/s; restitution 0 to 1 (per-ball overrides, sticking); friction, drag and
+//! gravity. A draw is a deterministic function of the seed and `k` (the [`SplitMix64`]
+//! stream), so a campaign is the same on every machine and at every commit.
+//!
+//! [`Invariants`] measures, in one sample of a run, what the engines promise: finite
+//! states, how far a ball reaches into another ball (minimum image in a periodic border),
+//! into a box at its place at that time or out of a reflecting border, and how far the
+//! energy rose above its start. The `stepped_fuzz` example runs campaigns with them;
+//! `tests/stepped_fuzz.rs` runs a small one in CI.
+
+use std::fmt::Write as _;
+
+use carom_math::{Real, Space, Vector};
+use nalgebra::Const;
+
+use super::SplitMix64;
+use crate::engine::BallStates;
+use crate::observe::energy;
+use crate::scene::{Scene, parse_scene};
+
+/// What one sample of a run shows (lengths in metres).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sample {
+    /// Every coordinate of every position and velocity is finite.
+    pub finite: bool,
+    /// The largest overlap of two balls (negative: the smallest gap).
+    pub ball_overlap: f64,
+    /// The largest overlap of a ball and a box (negative: the smallest gap).
+    pub box_overlap: f64,
+    /// The largest reach of a ball out of a reflecting border (negative: inside).
+    pub border_out: f64,
+    /// The energy's rise above its start beyond [`Invariants`]' allowance, over the
+    /// scene's energy scale; `None` for a scene with a moving box (which feeds energy in).
+    pub energy_rise: Option<f64>,
+}
+
+impl Sample {
+    /// The largest of the three excursions.
+    pub fn worst(&self) -> f64 {
+        self.ball_overlap.max(self.box_overlap).max(self.border_out)
+    }
+}
+
+/// What the checks need of a scene, worked out once from it and its start.
+#[derive(Clone, Debug)]
+pub struct Invariants {
+    resolution: f64,
+    mass: f64,
+    gravity_squared: f64,
+    energy_scale: f64,
+    start_energy: Option<f64>,
+}
+
+impl Invariants {
+    /// The invariants of `scene`, whose states at the start are `start`.
+    pub fn new<T: Real, const D: usize>(scene: &Scene<T, D>, start: &BallStates<T, D>) -> Self
+    where
+        Const<D>: Space<T, D>,
+    {
+        let mut largest = 1.0_f64;
+        for b in &scene.balls {
+            largest = b.pos.iter().fold(largest, |m, x| m.max(x.to_f64().abs()));
+        }
+        if let Some(border) = &scene.world.border {
+            let (lo, hi) = (border.border.min(), border.border.max());
+            largest = (lo.iter().chain(hi.iter())).fold(largest, |m, x| m.max(x.to_f64().abs()));
+        }
+        let mass: f64 = scene.balls.iter().map(|b| b.mass.to_f64()).sum();
+        let speed_energy: f64 = (scene.balls.iter())
+            .map(|b| 0.5 * b.mass.to_f64() * b.vel.norm_squared().to_f64())
+            .sum();
+        let g = scene.world.gravity.norm().to_f64();
+        let extent = scene.world.border.as_ref().map_or(1.0, |b| {
+            (b.border.extents().iter()).fold(0.0_f64, |m, x| m.max(x.to_f64()))
+        });
+        let moving_box = scene.boxes.iter().any(|b| b.vel.norm_squared() > T::zero());
+        Self {
+            resolution: T::EPSILON.to_f64() * largest,
+            mass,
+            gravity_squared: g * g,
+            // Kinetic energy plus the potential energy over the border's height: the scale
+            // a relative rise is measured against (the start's total may be near zero).
+            energy_scale: (speed_energy + mass * g * extent).max(f64::MIN_POSITIVE),
+            start_energy: (!moving_box).then(|| energy(scene, start).to_f64()),
+        }
+    }
+
+    /// The precision's resolution at the scene's largest coordinate, `ε · max|x|` (m).
+    pub fn resolution(&self) -> f64 {
+        self.resolution
+    }
+
+    /// The checks of the states at time `t` of a run with steps of `dt` (0 for the
+    /// event-driven engine). The energy may rise by `Σm |g|² dt t`, a first-order
+    /// scheme's truncation under gravity (explicit Euler gains `m g² dt²/2` per step in
+    /// free flight).
+    pub fn sample<T: Real, const D: usize>(
+        &self,
+        scene: &Scene<T, D>,
+        states: &BallStates<T, D>,
+        t: f64,
+        dt: f64,
+    ) -> Sample
+    where
+        Const<D>: Space<T, D>,
+    {
+        let wide = |v: &Vector<T, D>| v.map(T::to_f64);
+        let mut sample = Sample {
+            finite: (states.pos.iter().chain(&states.vel)).all(|v| v.iter().all(|x| x.finite())),
+            ball_overlap: f64::NEG_INFINITY,
+            box_overlap: f64::NEG_INFINITY,
+            border_out: f64::NEG_INFINITY,
+            energy_rise: None,
+        };
+        if !sample.finite {
+            return sample;
+        }
+        let border = scene.world.border.as_ref();
+        let periodic = (border.filter(|b| b.periodic)).map(|b| wide(&b.border.extents()));
+        let image = |mut d: Vector<f64, D>| {
+            if let Some(l) = &periodic {
+                for (x, l) in d.iter_mut().zip(l.iter()) {
+                    *x -= l * (*x / l).round();
+                }
+            }
+            d
+        };
+        let pos: Vec<Vector<f64, D>> = states.pos.iter().map(wide).collect();
+        let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius.to_f64()).collect();
+        for i in 0..pos.len() {
+            for j in i + 1..pos.len() {
+                let d = image(pos[j] - pos[i]).norm();
+                sample.ball_overlap = sample.ball_overlap.max(radius[i] + radius[j] - d);
+            }
+            if let Some(b) = border.filter(|b| !b.periodic) {
+                let (lo, hi) = (wide(&b.border.min()), wide(&b.border.max()));
+                for k in 0..D {
+                    let out = (lo[k] - (pos[i][k] - radius[i])).max(pos[i][k] + radius[i] - hi[k]);
+                    sample.border_out = sample.border_out.max(out);
+                }
+            }
+            for b in &scene.boxes {
+                let offset = image(pos[i] - (wide(&b.shape.center()) + wide(&b.vel) * t));
+                let local = Vector::<f64, D>::from_fn(|k, _| offset.dot(&wide(&b.shape.axis(k))));
+                let depth = radius[i] - box_distance(&local, &wide(&b.shape.half_extents()));
+                sample.box_overlap = sample.box_overlap.max(depth);
+            }
+        }
+        sample.energy_rise = self.start_energy.map(|start| {
+            let allowed = self.mass * self.gravity_squared * dt * t;
+            (energy(scene, states).to_f64() - start - allowed) / self.energy_scale
+        });
+        sample
+    }
+}
+
+/// The signed distance from a point in a box's frame to the box of half extents `half`
+/// (negative inside: minus the distance to the nearest face).
+fn box_distance<const D: usize>(local: &Vector<f64, D>, half: &Vector<f64, D>) -> f64 {
+    let outside = local.zip_map(half, |x, h| (x.abs() - h).max(0.0)).norm();
+    if outside > 0.0 {
+        return outside;
+    }
+    -local.zip_map(half, |x, h| h - x.abs()).min()
+}
+
+/// Scene `k` of the campaign `seed`, as scene-file text: retried with the next draw of
+/// its own stream until it is a valid scene in `f64` (the generator places bodies apart
+/// to its own tolerance; the loader decides).
+pub fn scene_text(seed: u64, k: usize) -> String {
+    let mut rng = SplitMix64::new(seed ^ (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    loop {
+        let text = if rng.next_f64() < 0.75 {
+            draw::<2>(&mut rng, k)
+        } else {
+            draw::<3>(&mut rng, k)
+        };
+        if parse_scene(&text).is_ok() {
+            return text;
+        }
+    }
+}
+
+/// A float as the scene file writes it (Rust's shortest round-trip form, with an exponent
+/// where it is shorter: TOML reads both).
+fn num(x: f64) -> String {
+    format!("{x:?}")
+}
+
+fn vector<const D: usize>(v: &[f64; D]) -> String {
+    let parts: Vec<String> = v.iter().map(|&x| num(x)).collect();
+    format!("[{}]", parts.join(", "))
+}
+
+/// Log-uniform in `[lo, hi]`.
+fn log_uniform(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
+    (rng.range(lo.ln(), hi.ln())).exp()
+}
+
+/// Where a scene's bodies may go: its border and the grid it snaps to.
+struct Frame<const D: usize> {
+    origin: f64,
+    half: f64,
+    periodic: bool,
+    /// The unit coordinates are rounded to (`None`: not rounded).
+    grid: Option<f64>,
+}
+
+impl<const D: usize> Frame<D> {
+    fn snap(&self, x: f64) -> f64 {
+        self.grid.map_or(x, |q| (x / q).round() * q)
+    }
+
+    /// A point whose ball of `margin` fits inside the border, snapped to the grid.
+    fn point(&self, rng: &mut SplitMix64, margin: f64) -> [f64; D] {
+        std::array::from_fn(|_| {
+            self.snap(self.origin + rng.range(-1.0, 1.0) * (self.half - margin).max(0.0))
+        })
+    }
+
+    /// The distance between two points (the minimum image in a periodic border).
+    fn distance(&self, p: &[f64; D], q: &[f64; D]) -> f64 {
+        let period = 2.0 * self.half;
+        (0..D)
+            .map(|a| {
+                let d = p[a] - q[a];
+                let d = if self.periodic {
+                    d - period * (d / period).round()
+                } else {
+                    d
+                };
+                d * d
+            })
+            .sum::<f64>()
+            .sqrt()
+    }
+}
+
+/// One draw of a `D`-dimensional scene.
+fn draw<const D: usize>(rng: &mut SplitMix64, k: usize) -> String {
+    let origin = match rng.next_f64() {
+        u if u < 0.5 => 0.0,
+        u if u < 0.8 => 1e3,
+        _ => -5e4,
+    };
+    // Half the scenes on a grid f32 holds exactly at their coordinates (its unit is at
+    // least 4 f32 ulps there), so that contacts touching in the file touch in f32 too.
+    let grid = (rng.next_f64() < 0.5).then_some(if origin == -5e4 {
+        0.015_625
+    } else {
+        1.0 / 1024.0
+    });
+    let frame = Frame::<D> {
+        origin,
+        half: [1.0, 2.0, 4.0][(rng.next_f64() * 3.0) as usize],
+        periodic: rng.next_f64() < 0.2,
+        grid,
+    };
+    let mut text = world(rng, k, &frame);
+    let boxes = boxes(rng, &frame, &mut text);
+    balls(rng, &frame, &boxes, &mut text);
+    text
+}
+
+/// The scene's header and `[world]` tables.
+fn world<const D: usize>(rng: &mut SplitMix64, k: usize, frame: &Frame<D>) -> String {
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "dim = {D}\nname = \"stepped-fuzz-s{k:02}\"\n\n[world]"
+    );
+    let restitution = match rng.next_f64() {
+        u if u < 0.3 => 1.0,
+        u if u < 0.5 => 0.0,
+        _ => frame.snap(rng.next_f64()),
+    };
+    let _ = writeln!(text, "restitution = {}", num(restitution));
+    if restitution == 0.0 && rng.next_f64() < 0.5 {
+        let _ = writeln!(text, "inelastic = \"stick\"");
+    }
+    if rng.next_f64() < 0.25 {
+        let _ = writeln!(text, "friction = {}", num(frame.snap(rng.next_f64())));
+    }
+    if rng.next_f64() < 0.2 {
+        let _ = writeln!(text, "drag = {}", num(log_uniform(rng, 1e-3, 1.0)));
+    }
+    if rng.next_f64() < 0.4 {
+        let mut g = [0.0; D];
+        g[D - 1] = -9.81;
+        let _ = writeln!(text, "gravity = {}", vector(&g));
+    }
+    let _ = writeln!(
+        text,
+        "\n[world.border]\nmin = {}\nmax = {}\nrestitution = {}\nperiodic = {}",
+        vector(&[frame.origin - frame.half; D]),
+        vector(&[frame.origin + frame.half; D]),
+        num([1.0, 0.0, 0.5][(rng.next_f64() * 3.0) as usize]),
+        frame.periodic
+    );
+    text
+}
+
+/// Up to three boxes, rotated or not, static or moving, inside the border; returns each
+/// one's centre and the radius of its bounding ball.
+fn boxes<const D: usize>(
+    rng: &mut SplitMix64,
+    frame: &Frame<D>,
+    text: &mut String,
+) -> Vec<([f64; D], f64)> {
+    let count = if rng.next_f64() < 0.5 {
+        0
+    } else {
+        1 + (rng.next_f64() * 3.0) as usize
+    };
+    (0..count)
+        .map(|_| {
+            let extents: [f64; D] =
+                std::array::from_fn(|_| frame.snap(frame.half * log_uniform(rng, 0.05, 0.3)));
+            let reach = extents.iter().map(|e| e * e).sum::<f64>().sqrt();
+            let centre = frame.point(rng, reach);
+            let vel: [f64; D] = if rng.next_f64() < 0.5 {
+                let speed = log_uniform(rng, 0.1, 100.0);
+                rng.direction::<D>().map(|x| x * speed)
+            } else {
+                [0.0; D]
+            };
+            let _ = writeln!(
+                text,
+                "\n[[boxes]]\ncenter = {}\nhalf_extents = {}\nvel = {}\nrestitution = {}",
+                vector(&centre),
+                vector(&extents),
+                vector(&vel),
+                num(frame.snap(rng.next_f64()))
+            );
+            if rng.next_f64() < 0.5 {
+                let angle = rng.range(-3.0, 3.0);
+                if D == 2 {
+                    let _ = writeln!(text, "angle = {}", num(angle));
+                } else {
+                    let axis = rng.direction::<3>().map(|x| x * angle);
+                    let _ = writeln!(text, "axis_angle = {}", vector(&axis));
+                }
+            }
+            (centre, reach)
+        })
+        .collect()
+}
+
+/// 2 to 40 balls (few more often than many), apart from each other and the boxes; a
+/// quarter of them placed touching another ball along an axis, a tenth touching a wall.
+fn balls<const D: usize>(
+    rng: &mut SplitMix64,
+    frame: &Frame<D>,
+    boxes: &[([f64; D], f64)],
+    text: &mut String,
+) {
+    let (lo, hi) = (frame.origin - frame.half, frame.origin + frame.half);
+    let n = 2 + (38.0 * rng.next_f64().powi(2)) as usize;
+    let mut placed: Vec<([f64; D], f64)> = Vec::new();
+    for _ in 0..n {
+        let radius = frame
+            .snap(frame.half * log_uniform(rng, 5e-3, 0.12))
+            .max(frame.grid.unwrap_or(0.0) * 4.0);
+        for _attempt in 0..100 {
+            let pos: [f64; D] = match rng.next_f64() {
+                u if u < 0.25 && !placed.is_empty() => {
+                    let (other, r) = placed[(rng.next_f64() * placed.len() as f64) as usize];
+                    let axis = (rng.next_f64() * D as f64) as usize;
+                    let sign = if rng.next_f64() < 0.5 { -1.0 } else { 1.0 };
+                    let mut p = other;
+                    p[axis] += sign * (r + radius);
+                    p
+                }
+                u if u < 0.35 && !frame.periodic => {
+                    let mut p = frame.point(rng, radius);
+                    let axis = (rng.next_f64() * D as f64) as usize;
+                    p[axis] = if rng.next_f64() < 0.5 {
+                        lo + radius
+                    } else {
+                        hi - radius
+                    };
+                    p
+                }
+                _ => frame.point(rng, radius),
+            };
+            let inside = frame.periodic || pos.iter().all(|x| x - radius >= lo && x + radius <= hi);
+            let apart = (placed.iter())
+                .all(|(q, r)| frame.distance(&pos, q) >= (r + radius) * (1.0 - 1e-15));
+            let off_boxes =
+                (boxes.iter()).all(|(c, reach)| frame.distance(&pos, c) > reach + radius);
+            if inside && apart && off_boxes {
+                placed.push((pos, radius));
+                break;
+            }
+        }
+    }
+    for (pos, radius) in &placed {
+        let mass = if rng.next_f64() < 0.5 {
+            log_uniform(rng, 1e-6, 1e6)
+        } else {
+            log_uniform(rng, 0.1, 10.0)
+        };
+        let speed = match rng.next_f64() {
+            u if u < 0.1 => 0.0,
+            u if u < 0.2 => log_uniform(rng, 1e3, 1e6),
+            u if u < 0.5 => log_uniform(rng, 1.0, 100.0),
+            _ => log_uniform(rng, 1e-2, 3.0),
+        };
+        let vel = rng.direction::<D>().map(|x| x * speed);
+        let _ = writeln!(
+            text,
+            "\n[[balls]]\npos = {}\nvel = {}\nradius = {}\nmass = {}",
+            vector(pos),
+            vector(&vel),
+            num(*radius),
+            num(mass)
+        );
+        if rng.next_f64() < 0.2 {
+            let _ = writeln!(text, "restitution = {}", num(frame.snap(rng.next_f64())));
+        }
+    }
+}
