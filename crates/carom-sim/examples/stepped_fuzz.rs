@@ -48,7 +48,7 @@ use carom_math::{Real, Space};
 use carom_sim::observe::state_hash;
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};
 use carom_sim::scene::{LoadedScene, Scene, parse_scene};
-use carom_sim::scenes::fuzz::{Invariants, scene_text};
+use carom_sim::scenes::fuzz::{Invariants, failure_kind, scene_text};
 use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Simulation};
 use carom_toi::Direction;
@@ -271,23 +271,9 @@ fn refusal(kind: &str, message: &str) -> Outcome {
     }
 }
 
-/// The kind of an engine error, from its message.
-fn error_kind(message: &str) -> &'static str {
-    const KINDS: [(&str, &str); 4] = [
-        ("is crushed", "crush"),
-        ("spins at", "spin"),
-        (" moves at ", "moves-at"),
-        ("overflowed", "overflow"),
-    ];
-    KINDS
-        .iter()
-        .find(|(needle, _)| message.contains(needle))
-        .map_or("error", |(_, kind)| kind)
-}
-
 fn run_scene<T: Real, const D: usize>(scene: &Scene<T, D>, run: Run, settings: &Settings) -> Outcome
 where
-    Const<D>: Space<T, D>,
+    Const<D>: Space<T, D> + Space<f64, D>,
 {
     let options = RunOptions {
         engine: EngineChoice::Stepped,
@@ -297,8 +283,7 @@ where
     };
     let p = match plan(scene, &options) {
         Ok(p) => p,
-        Err(e) if e.0.contains("world.drag") => return refusal("drag-refusal", &e.0),
-        Err(e) => return refusal("refused", &e.0),
+        Err(e) => return refusal(failure_kind(&e.0).unwrap_or("refused"), &e.0),
     };
     let mut sim = match SteppedEngine::new(scene, &p, Direction::Forward) {
         Ok(sim) => sim,
@@ -318,7 +303,7 @@ where
         if let Err(e) = sim.advance_to(T::lit(t), &mut ()) {
             // The state after an error is for diagnosis only (`Simulation::advance_to`):
             // the checks stop at the last sample before it.
-            outcome.kind = error_kind(&e.message).into();
+            outcome.kind = failure_kind(&e.message).unwrap_or("error").into();
             outcome.end = e.time;
             outcome.message = e.message;
             break;

@@ -18,8 +18,10 @@
 
 use std::fmt::Write as _;
 
+use carom_geometry::query::signed_distance;
+use carom_geometry::{Ball, Obb};
 use carom_math::{Real, Space, Vector};
-use nalgebra::Const;
+use nalgebra::{Const, Rotation};
 
 use super::SplitMix64;
 use crate::engine::BallStates;
@@ -51,7 +53,15 @@ impl Sample {
 
 /// What the checks need of a scene, worked out once from it and its start.
 #[derive(Clone, Debug)]
-pub struct Invariants {
+pub struct Invariants<const D: usize>
+where
+    Const<D>: Space<f64, D>,
+{
+    /// The balls' radii, the boxes at time 0 with their velocities, and the border's
+    /// corners and periods (when periodic), widened to `f64`, where the checks measure.
+    radius: Vec<f64>,
+    boxes: Vec<(Obb<f64, D>, Vector<f64, D>)>,
+    border: Option<(Vector<f64, D>, Vector<f64, D>, bool)>,
     resolution: f64,
     mass: f64,
     gravity_squared: f64,
@@ -59,12 +69,30 @@ pub struct Invariants {
     start_energy: Option<f64>,
 }
 
-impl Invariants {
+impl<const D: usize> Invariants<D>
+where
+    Const<D>: Space<f64, D>,
+{
     /// The invariants of `scene`, whose states at the start are `start`.
-    pub fn new<T: Real, const D: usize>(scene: &Scene<T, D>, start: &BallStates<T, D>) -> Self
+    pub fn new<T: Real>(scene: &Scene<T, D>, start: &BallStates<T, D>) -> Self
     where
         Const<D>: Space<T, D>,
     {
+        let wide = |v: &Vector<T, D>| v.map(T::to_f64);
+        // Widened exactly, and not checked again: an `f32` rotation is orthonormal only
+        // to `f32`'s precision, which `Obb::new` in `f64` would refuse.
+        let boxes = (scene.boxes.iter())
+            .map(|b| {
+                let rotation =
+                    Rotation::from_matrix_unchecked(b.shape.rotation().matrix().map(T::to_f64));
+                let shape = Obb::new_unchecked(
+                    wide(&b.shape.center()),
+                    wide(&b.shape.half_extents()),
+                    rotation,
+                );
+                (shape, wide(&b.vel))
+            })
+            .collect();
         let mut largest = 1.0_f64;
         for b in &scene.balls {
             largest = b.pos.iter().fold(largest, |m, x| m.max(x.to_f64().abs()));
@@ -83,6 +111,10 @@ impl Invariants {
         });
         let moving_box = scene.boxes.iter().any(|b| b.vel.norm_squared() > T::zero());
         Self {
+            radius: scene.balls.iter().map(|b| b.radius.to_f64()).collect(),
+            boxes,
+            border: (scene.world.border.as_ref())
+                .map(|b| (wide(&b.border.min()), wide(&b.border.max()), b.periodic)),
             resolution: T::EPSILON.to_f64() * largest,
             mass,
             gravity_squared: g * g,
@@ -102,7 +134,7 @@ impl Invariants {
     /// event-driven engine). The energy may rise by `Σm |g|² dt t`, a first-order
     /// scheme's truncation under gravity (explicit Euler gains `m g² dt²/2` per step in
     /// free flight).
-    pub fn sample<T: Real, const D: usize>(
+    pub fn sample<T: Real>(
         &self,
         scene: &Scene<T, D>,
         states: &BallStates<T, D>,
@@ -123,8 +155,7 @@ impl Invariants {
         if !sample.finite {
             return sample;
         }
-        let border = scene.world.border.as_ref();
-        let periodic = (border.filter(|b| b.periodic)).map(|b| wide(&b.border.extents()));
+        let periodic = (self.border.filter(|b| b.2)).map(|(lo, hi, _)| hi - lo);
         let image = |mut d: Vector<f64, D>| {
             if let Some(l) = &periodic {
                 for (x, l) in d.iter_mut().zip(l.iter()) {
@@ -133,24 +164,23 @@ impl Invariants {
             }
             d
         };
-        let pos: Vec<Vector<f64, D>> = states.pos.iter().map(wide).collect();
-        let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius.to_f64()).collect();
-        for i in 0..pos.len() {
-            for j in i + 1..pos.len() {
-                let d = image(pos[j] - pos[i]).norm();
-                sample.ball_overlap = sample.ball_overlap.max(radius[i] + radius[j] - d);
+        for (i, (x, &r)) in states.pos.iter().zip(&self.radius).enumerate() {
+            let x = wide(x);
+            for (y, &q) in states.pos.iter().zip(&self.radius).skip(i + 1) {
+                let d = image(wide(y) - x).norm();
+                sample.ball_overlap = sample.ball_overlap.max(r + q - d);
             }
-            if let Some(b) = border.filter(|b| !b.periodic) {
-                let (lo, hi) = (wide(&b.border.min()), wide(&b.border.max()));
+            if let Some((lo, hi, false)) = &self.border {
                 for k in 0..D {
-                    let out = (lo[k] - (pos[i][k] - radius[i])).max(pos[i][k] + radius[i] - hi[k]);
+                    let out = (lo[k] - (x[k] - r)).max(x[k] + r - hi[k]);
                     sample.border_out = sample.border_out.max(out);
                 }
             }
-            for b in &scene.boxes {
-                let offset = image(pos[i] - (wide(&b.shape.center()) + wide(&b.vel) * t));
-                let local = Vector::<f64, D>::from_fn(|k, _| offset.dot(&wide(&b.shape.axis(k))));
-                let depth = radius[i] - box_distance(&local, &wide(&b.shape.half_extents()));
+            for (shape, vel) in &self.boxes {
+                // The box at time `t`, in its periodic image nearest the ball.
+                let centre = shape.center() + vel * t;
+                let at = shape.translated(&(x - centre - image(x - centre) + vel * t));
+                let depth = -signed_distance(&Ball::new_unchecked(x, r), &at);
                 sample.box_overlap = sample.box_overlap.max(depth);
             }
         }
@@ -162,14 +192,26 @@ impl Invariants {
     }
 }
 
-/// The signed distance from a point in a box's frame to the box of half extents `half`
-/// (negative inside: minus the distance to the nearest face).
-fn box_distance<const D: usize>(local: &Vector<f64, D>, half: &Vector<f64, D>) -> f64 {
-    let outside = local.zip_map(half, |x, h| (x.abs() - h).max(0.0)).norm();
-    if outside > 0.0 {
-        return outside;
+/// The kind of a run's failure, from its message: `crush` (a ball held against more
+/// contacts at one instant than the engine takes), `spin` (a cluster spinning too fast
+/// for the step), `moves-at` (a speed the periodic window cannot follow), `overflow` (a
+/// time of impact out of the precision's range), `drag-refusal` (the planner's refusal
+/// of a step too long for the scene's drag), or `None` for a failure the engines do not
+/// name.
+pub fn failure_kind(message: &str) -> Option<&'static str> {
+    const KINDS: [(&str, &str); 4] = [
+        ("is crushed", "crush"),
+        ("spins at", "spin"),
+        (" moves at ", "moves-at"),
+        ("overflowed", "overflow"),
+    ];
+    if message.starts_with("--dt") && message.contains("world.drag") {
+        return Some("drag-refusal");
     }
-    -local.zip_map(half, |x, h| h - x.abs()).min()
+    KINDS
+        .iter()
+        .find(|(needle, _)| message.contains(needle))
+        .map(|&(_, kind)| kind)
 }
 
 /// Scene `k` of the campaign `seed`, as scene-file text: retried with the next draw of
