@@ -291,7 +291,7 @@ where
     };
     let mut states = BallStates::default();
     sim.states(&mut states);
-    let invariants = Invariants::new(scene, &states);
+    let mut invariants = Invariants::new(scene, &states);
     let mut outcome = Outcome {
         kind: "completed".into(),
         resolution: invariants.resolution(),

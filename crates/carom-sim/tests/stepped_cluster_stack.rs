@@ -37,7 +37,7 @@ use carom_integrate::Integrator;
 use carom_math::{Space, Vector};
 use carom_sim::scene::{BallSpec, BorderSpec, Inelastic, Scene, World};
 use carom_sim::{Collision, Simulation, observe};
-use common::{Recorder, assert_stays_put, states, stepped};
+use common::{Recorder, assert_stays_put, spanning_the_origin, states, stepped};
 use nalgebra::Const;
 
 const G: f64 = 9.81;
@@ -554,15 +554,20 @@ fn far_from_the_origin_the_stack_stays_put_to_the_rounding_of_its_coordinates() 
         border.border =
             Border::new(border.border.min() + shift, border.border.max() + shift).unwrap();
     }
+    // Computed in the scene's own coordinates (a box at the origin) and from its middle.
     let tolerance = 64.0 * f64::EPSILON * offset * 2f64.sqrt();
-    for integrator in [Integrator::SemiImplicitEuler, Integrator::Exact] {
-        let mut sim = stepped(&s, integrator, DT);
+    let frames = [(spanning_the_origin(&s), "own"), (s, "middle")];
+    for ((s, frame), integrator) in frames
+        .iter()
+        .flat_map(|f| [Integrator::SemiImplicitEuler, Integrator::Exact].map(|i| (f, i)))
+    {
+        let mut sim = stepped(s, integrator, DT);
         let mut rec = Recorder::default();
         sim.advance_to(1.0, &mut rec).unwrap();
-        let what = format!("at 1e6, {integrator}");
+        let what = format!("at 1e6, {frame} coordinates, {integrator}");
         assert_stays_put(
             &mut sim,
-            &s,
+            s,
             &rest,
             1.0 + HOLD,
             20,

@@ -14,7 +14,7 @@ use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;
 use carom_sim::Simulation;
 use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
-use common::{Recorder, assert_stays_put, states, stepped};
+use common::{Recorder, assert_stays_put, spanning_the_origin, states, stepped};
 use nalgebra::Vector2;
 
 const G: f64 = 9.81;
@@ -406,11 +406,12 @@ fn a_ball_on_the_floor_pushed_in_by_a_light_ball_sinks_no_more_than_the_narrow_p
 /// with every integrator. A pair overlapping deeper than that floor lets a contact sink
 /// in a step (`Allowance::sunk_depth`: 9.8e-10 m, plus the contacts' rounding) now has
 /// any approach beyond rounding answered. Every step for 2 s, every integrator, both
-/// places: no deeper than twice that depth plus a step at the pair's approach.
+/// places (far out, in the scene's own coordinates too: a box at the origin): no deeper
+/// than twice that depth plus a step at the pair's approach.
 #[test]
 fn balls_rolling_side_by_side_closing_slower_than_the_resting_floor_do_not_sink_into_each_other() {
     let (r, v, faster, dt) = (0.05, 0.64, 6.7e-8, 0.01);
-    for x0 in [0.0, 5e4] {
+    for (x0, own_coordinates) in [(0.0, false), (5e4, false), (5e4, true)] {
         let mut world = floor_world(0.5, 0.3, 20.0);
         world.border = Some(BorderSpec {
             border: Border::new(Vector2::new(x0 - 10.0, 0.0), Vector2::new(x0 + 10.0, 10.0))
@@ -418,7 +419,7 @@ fn balls_rolling_side_by_side_closing_slower_than_the_resting_floor_do_not_sink_
             restitution: 0.5,
             periodic: false,
         });
-        let s = Scene {
+        let near = Scene {
             world,
             balls: vec![
                 BallSpec::new(Vector2::new(x0, r), Vector2::new(v + faster, 0.0), r, 1.0),
@@ -429,11 +430,16 @@ fn balls_rolling_side_by_side_closing_slower_than_the_resting_floor_do_not_sink_
         let rounding = |x: f64| 1e-9 * r + 16.0 * f64::EPSILON * (x + r);
         let floor_depth = 1e-6 * G * dt * dt + 2.0 * rounding(x0 + 1.0);
         let allowed = 2.0 * floor_depth + faster * dt;
+        let s = if own_coordinates {
+            spanning_the_origin(&near)
+        } else {
+            near
+        };
         common::each_step(&s, dt, 200, |integrator, k, sim| {
             let overlap = common::deepest_overlap(&s, &states(sim));
             assert!(
                 overlap <= allowed,
-                "{integrator}, {x0} m out, step {k}: overlap {overlap:e} m (allowed {allowed:e})"
+                "{integrator}, {x0} m out, own coordinates {own_coordinates}, step {k}: overlap {overlap:e} m (allowed {allowed:e})"
             );
         });
     }

@@ -17,7 +17,10 @@ use carom_sim::scenes::gas::{GasParams, gas};
 use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Collision, EngineKind, EventEngine, Simulation, observe};
 use carom_toi::Direction;
-use common::{Recorder, deepest_overlap, each_step, outside_border, scene_2d, states, stepped};
+use common::{
+    Recorder, deepest_overlap, each_step, outside_border, scene_2d, spanning_the_origin, states,
+    stepped,
+};
 use nalgebra::{Const, Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector2, Vector3};
 
 type Angular<const D: usize> = <Const<D> as Space<f64, D>>::Angular;
@@ -1122,18 +1125,21 @@ fn a_spinning_cluster_held_in_a_corner_from_the_start_of_each_sub_step_runs_on()
         radius = 0.059567934567242714
         mass = 2.1036320154494876
     "#;
-    let s = scene_2d(SCENE);
-    each_step(&s, 0.01, 200, |integrator, k, sim| {
-        // The coordinates' resolution here: 50,000 m in f64 is 7e-12 m.
-        let outside = outside_border(&s, &states(sim));
-        assert!(
-            outside <= 1e-9,
-            "{integrator}, step {k}: {outside} m outside"
-        );
-        if k == 200 {
-            assert_eq!(sim.counters().ball_ball, 1, "{integrator}: one fusion");
-        }
-    });
+    // Computed from the scene's middle, and in its own coordinates (a box at the origin),
+    // whose resolution 50,000 m out is 7e-12 m in f64.
+    let near = scene_2d(SCENE);
+    for s in [spanning_the_origin(&near), near] {
+        each_step(&s, 0.01, 200, |integrator, k, sim| {
+            let outside = outside_border(&s, &states(sim));
+            assert!(
+                outside <= 1e-9,
+                "{integrator}, step {k}: {outside} m outside"
+            );
+            if k == 200 {
+                assert_eq!(sim.counters().ball_ball, 1, "{integrator}: one fusion");
+            }
+        });
+    }
 }
 
 /// The number that follows the first `key` in `message`, up to the next space.
@@ -1275,14 +1281,20 @@ const STUCK_CLUSTERS_FUSING_FAR_FROM_THE_ORIGIN: &str =
 
 #[test]
 fn clusters_fusing_on_a_floor_far_from_the_origin_run_on() {
-    let s = scene_2d(STUCK_CLUSTERS_FUSING_FAR_FROM_THE_ORIGIN);
-    let mut sim = stepped(&s, Integrator::VelocityVerlet, 0.01);
-    for k in 1..=90 {
-        sim.advance_to(0.01 * f64::from(k), &mut ())
-            .unwrap_or_else(|e| panic!("step {k}: {e}"));
+    // Computed from the scene's middle, and in its own coordinates (a box at the origin).
+    let near = scene_2d(STUCK_CLUSTERS_FUSING_FAR_FROM_THE_ORIGIN);
+    for (s, frame) in [(spanning_the_origin(&near), "own"), (near, "middle")] {
+        let mut sim = stepped(&s, Integrator::VelocityVerlet, 0.01);
+        for k in 1..=90 {
+            sim.advance_to(0.01 * f64::from(k), &mut ())
+                .unwrap_or_else(|e| panic!("{frame} coordinates, step {k}: {e}"));
+        }
+        let st = states(&sim);
+        assert!(outside_border(&s, &st) <= 1e-9, "{frame} coordinates");
+        let overlap = deepest_overlap(&s, &st);
+        assert!(
+            overlap <= 1e-9,
+            "{frame} coordinates: balls overlap by {overlap:e}"
+        );
     }
-    let st = states(&sim);
-    assert!(outside_border(&s, &st) <= 1e-9);
-    let overlap = deepest_overlap(&s, &st);
-    assert!(overlap <= 1e-9, "balls overlap by {overlap:e}");
 }

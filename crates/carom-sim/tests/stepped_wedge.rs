@@ -23,7 +23,9 @@ use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
 use carom_sim::stepped::StepStats;
 use carom_sim::{BallStates, EngineKind, EventEngine, Simulation};
 use carom_toi::Direction;
-use common::{deepest_overlap, outside_border, scene_2d, states, stepped, stepped_with};
+use common::{
+    deepest_overlap, outside_border, scene_2d, spanning_the_origin, states, stepped, stepped_with,
+};
 use nalgebra::{Const, Vector2, Vector3};
 
 const DT: f64 = 0.01;
@@ -729,16 +731,19 @@ fn ball_pressed_along_a_box_face(angle: f64) -> Scene<f64, 2> {
 
 #[test]
 fn a_light_ball_pressed_along_a_box_face_far_from_the_origin_is_not_taken_for_crushed() {
+    // Computed from the scene's middle, and in its own coordinates (a box at the origin).
     for angle in [-2.129, 0.5, 1.1, 2.7] {
-        let s = ball_pressed_along_a_box_face(angle);
-        let face = s.boxes[0].shape;
-        for integrator in Integrator::ALL {
-            run_steps(&s, integrator, 10, |what, st, e_before, e| {
-                let what = format!("{angle} rad, {what}");
-                assert_held(&s, st, &what, e_before, e);
-                let into = s.balls[0].radius - face.signed_distance_to_point(&st.pos[0]);
-                assert!(into <= 1e-9, "{what}: {into:e} m into the box");
-            });
+        let near = ball_pressed_along_a_box_face(angle);
+        let face = near.boxes[0].shape;
+        for (s, frame) in [(spanning_the_origin(&near), "own"), (near, "middle")] {
+            for integrator in Integrator::ALL {
+                run_steps(&s, integrator, 10, |what, st, e_before, e| {
+                    let what = format!("{angle} rad, {frame} coordinates, {what}");
+                    assert_held(&s, st, &what, e_before, e);
+                    let into = s.balls[0].radius - face.signed_distance_to_point(&st.pos[0]);
+                    assert!(into <= 1e-9, "{what}: {into:e} m into the box");
+                });
+            }
         }
     }
 }

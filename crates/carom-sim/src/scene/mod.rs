@@ -8,6 +8,7 @@
 //! in `f64`); [`Scene::cast`] converts to `f32` for `--precision f32`.
 
 mod file;
+mod origin;
 mod validate;
 
 use carom_geometry::{Border, Obb};

@@ -201,6 +201,10 @@ where
     /// The largest distance a ball may move in one window of a periodic domain.
     periodic_reach: T,
     escape_bound: usize,
+    /// Where the scene's origin is in the engine's coordinates: positions are computed
+    /// from the scene's middle, finer far from the origin, and reported with this added
+    /// back ([`Scene::recentred`]).
+    origin: Vector<T, D>,
 }
 
 /// A chunk's segment starts: positions, velocities, spins, times.
@@ -278,6 +282,9 @@ where
         plan: &Plan,
         direction: Direction,
     ) -> Result<Self, SceneError> {
+        // Positions are computed from the scene's middle and reported from the origin.
+        let (scene, origin) = scene.recentred();
+        let scene = &scene;
         let n = scene.balls.len();
         if u32::try_from(n + scene.boxes.len()).is_err() {
             return Err(SceneError::new("balls", "more than 2^32 balls and boxes"));
@@ -343,6 +350,7 @@ where
             step_length: T::lit(dt),
             periodic_reach,
             escape_bound: 64.max(n / 16),
+            origin,
         };
         engine.pipeline = engine.describe(scene, integrator);
         Ok(engine)
@@ -447,7 +455,7 @@ where
 
     /// Box `k`'s centre now, or `None` if there is no box `k`.
     pub fn box_center(&self, k: usize) -> Option<Vector<T, D>> {
-        self.boxes.shape.get(k).map(carom_geometry::Obb::center)
+        self.boxes.shape.get(k).map(|b| b.center() + self.origin)
     }
 
     /// The step `dt` (s).
@@ -1433,7 +1441,8 @@ where
     fn states(&self, out: &mut BallStates<T, D>) {
         let sign = self.clock.sign;
         out.reset(self.balls.len());
-        out.pos.extend_from_slice(&self.balls.pos);
+        out.pos
+            .extend(self.balls.pos.iter().map(|p| p + self.origin));
         out.vel.extend(self.balls.vel.iter().map(|v| v * sign));
         out.spin.extend(self.balls.spin.iter().map(|w| *w * sign));
     }

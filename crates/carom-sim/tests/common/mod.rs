@@ -49,6 +49,32 @@ where
     SteppedEngine::new(scene, &p, direction).expect("a valid scene")
 }
 
+/// `scene` with a static 1 cm box added at the origin, out of every ball's way: a scene
+/// far from the origin is then no longer on one side of it, so the engine computes in
+/// the scene's own coordinates ([`Scene::recentred`] moves nothing) and meets the
+/// rounding of positions that far out, which recentring otherwise spares it.
+pub(crate) fn spanning_the_origin<T: Real, const D: usize>(scene: &Scene<T, D>) -> Scene<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    let mut s = scene.clone();
+    let shape = carom_geometry::Obb::from_aabb(&carom_geometry::Aabb::new_unchecked(
+        Vector::repeat(T::lit(-0.005)),
+        Vector::repeat(T::lit(0.005)),
+    ));
+    s.boxes.push(carom_sim::scene::BoxSpec {
+        shape,
+        vel: Vector::zeros(),
+        restitution: T::one(),
+    });
+    assert_eq!(
+        s.middle(),
+        Vector::<T, D>::zeros(),
+        "the box keeps the origin"
+    );
+    s
+}
+
 /// The 2D scene of the scene-file text `text`.
 pub(crate) fn scene_2d(text: &str) -> Scene<f64, 2> {
     match parse_scene(text).expect("a valid scene") {
