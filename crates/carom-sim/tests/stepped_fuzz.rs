@@ -153,7 +153,7 @@ fn worst_in_units(
     dt: f64,
     until: f64,
 ) -> (f64, BallStates<f32, 2>) {
-    let mut sim = common_stepped(scene, integrator, dt);
+    let mut sim = stepped(scene, integrator, dt);
     let mut states = BallStates::default();
     sim.states(&mut states);
     let mut invariants = Invariants::new(scene, &states);
@@ -169,7 +169,14 @@ fn worst_in_units(
 }
 
 /// The stepped engine for `scene` with `integrator` and steps of `dt`.
-fn common_stepped(scene: &Scene<f32, 2>, integrator: Integrator, dt: f64) -> SteppedEngine<f32, 2> {
+fn stepped<T: Real, const D: usize>(
+    scene: &Scene<T, D>,
+    integrator: Integrator,
+    dt: f64,
+) -> SteppedEngine<T, D>
+where
+    Const<D>: Space<T, D>,
+{
     let options = RunOptions {
         engine: EngineChoice::Stepped,
         integrator: Some(integrator),
@@ -194,21 +201,7 @@ fn in_f32_far_from_the_origin_a_slow_ball_follows_its_velocity_and_no_moving_box
     let LoadedScene::D2(wide) = parse_scene(text).unwrap() else {
         unreachable!()
     };
-    let mut sim = SteppedEngine::new(
-        &wide,
-        &plan(
-            &wide,
-            &RunOptions {
-                engine: EngineChoice::Stepped,
-                integrator: Some(Integrator::Exact),
-                dt: Some(0.01),
-                broad: BroadChoice::Auto,
-            },
-        )
-        .unwrap(),
-        Direction::Forward,
-    )
-    .unwrap();
+    let mut sim = stepped(&wide, Integrator::Exact, 0.01);
     sim.advance_to(0.7, &mut ()).unwrap();
     let mut reference = BallStates::default();
     sim.states(&mut reference);
