@@ -21,6 +21,8 @@
 //! from the origin, a ball too slow for its coordinates under a moving box, and a pair
 //! struck apart by a light ball between them.
 
+mod common;
+
 use carom_integrate::Integrator;
 use carom_math::{Real, Space};
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};
@@ -29,6 +31,7 @@ use carom_sim::scenes::fuzz::{Invariants, failure_kind, scene_text};
 use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Simulation};
 use carom_toi::Direction;
+use common::stepped;
 use nalgebra::Const;
 use rayon::prelude::*;
 
@@ -166,25 +169,6 @@ fn worst_in_units(
         worst = worst.max(invariants.sample(scene, &states, t, dt).worst());
     }
     (worst / invariants.resolution(), states)
-}
-
-/// The stepped engine for `scene` with `integrator` and steps of `dt`.
-fn stepped<T: Real, const D: usize>(
-    scene: &Scene<T, D>,
-    integrator: Integrator,
-    dt: f64,
-) -> SteppedEngine<T, D>
-where
-    Const<D>: Space<T, D>,
-{
-    let options = RunOptions {
-        engine: EngineChoice::Stepped,
-        integrator: Some(integrator),
-        dt: Some(dt),
-        broad: BroadChoice::Auto,
-    };
-    let p = plan(scene, &options).expect("a valid plan");
-    SteppedEngine::new(scene, &p, Direction::Forward).expect("a valid scene")
 }
 
 /// √2 units: the most rounding two reported 2D positions to `f32` can show.
