@@ -69,7 +69,7 @@ use nalgebra::Const;
 use carom_response::RigidCluster;
 
 use super::clusters::{FREE, Flight, Motion};
-use super::narrow::{Target, sunk, touch_tolerance};
+use super::narrow::{Target, sunk, time_resolved_gap, touch_tolerance};
 use super::response::{Contacts, Effect};
 use super::stick::Side;
 use super::sweep::path_box;
@@ -190,6 +190,15 @@ where
 {
     fn find(&self, side: Side) -> Option<usize> {
         self.parts.iter().position(|p| p.side == side)
+    }
+
+    /// What [`time_resolved_gap`] takes for the step's length `h` in this stack's hold:
+    /// `h` in a wedge's, zero in another (which leaves gaps as they are).
+    fn wedge_step(&self, h: T) -> T {
+        match self.approach {
+            Approach::Any => h,
+            Approach::Slow => T::zero(),
+        }
     }
 
     /// The Delassus matrix of `rows` (row-major, `rows.len()` square):
@@ -950,6 +959,8 @@ where
         };
         let tolerance = touch_tolerance(&p, r);
         let near = |gap: T, closing: T| gap <= tolerance || closing * rest > gap;
+        // A wedge's hold takes a gap the time of impact cannot resolve for none.
+        let wedge_h = stack.wedge_step(self.h);
         let centre = stack.parts[k].centre;
         let end = |n: &Vector<T, D>| End {
             part: k,
@@ -958,6 +969,7 @@ where
             lever: n * r,
         };
         self.for_each_surface(x, s, |target, n, v, gap| {
+            let gap = time_resolved_gap(gap, wedge_h, chord.norm() + v.norm());
             if near(gap, (chord - v).dot(&n)) {
                 stack.rows.push(Row {
                     end: end(&n),
@@ -996,12 +1008,13 @@ where
             // radii) and takes any approach past the allowance for a contact now, where
             // the gap over the rest of the step would let the hold leave one (a 1 g ball
             // in a corner, its neighbour one ulp off, 2.8e-17 m, left closing at 3.2e-14
-            // m/s against 4.8e-14 over 5.8e-4 s, was found again 16,384 times).
+            // m/s against 4.8e-14 over 5.8e-4 s, was found again 16,384 times). Nor, in a
+            // wedge's hold, is one the in-step time cannot resolve at their speeds.
             let gap = d - r - b.radius[j];
             let gap = if gap <= coordinate_resolution(p.amax().max(y.amax())) {
                 T::zero()
             } else {
-                gap
+                time_resolved_gap(gap, wedge_h, chord.norm() + b.chord[j].norm())
             };
             if !near(gap, (chord - b.chord[j]).dot(&n)) {
                 continue;
