@@ -195,17 +195,23 @@ fn in_f32_far_from_the_origin_a_slow_ball_follows_its_velocity_and_no_moving_box
     assert!(apart <= unit, "{apart} m from the f64 run's place");
 }
 
+/// Runs `scene` with every integrator, steps of `dt` to `until` (an error panics), and
+/// asserts that no sample overlaps beyond the rounding of the reported positions.
+fn within_reported_rounding_with_every_integrator(scene: &Scene<f32, 2>, dt: f64, until: f64) {
+    for integrator in Integrator::ALL {
+        let (worst, _) = worst_in_units(scene, integrator, dt, until);
+        assert!(worst <= REPORTED_ROUNDING_2D, "{integrator}: {worst} units");
+    }
+}
+
 #[test]
 fn in_f32_far_from_the_origin_a_pair_struck_apart_by_a_rattling_light_ball_does_not_sink() {
     let scene = f32_scene(include_str!(
         "scenes/f32_struck_pair_far_from_the_origin.toml"
     ));
-    for integrator in Integrator::ALL {
-        // One step, sampled at its end only: computed in the scene's own coordinates,
-        // 9 units of overlap.
-        let (worst, _) = worst_in_units(&scene, integrator, 0.003, 0.003);
-        assert!(worst <= REPORTED_ROUNDING_2D, "{integrator}: {worst} units");
-    }
+    // One step, sampled at its end only: computed in the scene's own coordinates, 9 units
+    // of overlap.
+    within_reported_rounding_with_every_integrator(&scene, 0.003, 0.003);
 }
 
 #[test]
@@ -213,9 +219,6 @@ fn in_f32_a_light_ball_between_balls_converging_on_it_fast_is_held_not_crushed()
     let scene = f32_scene(include_str!(
         "scenes/f32_light_ball_between_fast_converging_balls.toml"
     ));
-    for integrator in Integrator::ALL {
-        // Before: a crush error at 0.0090 s with the exact and Verlet integrators.
-        let (worst, _) = worst_in_units(&scene, integrator, 0.01, 0.1);
-        assert!(worst <= REPORTED_ROUNDING_2D, "{integrator}: {worst} units");
-    }
+    // Before: a crush error at 0.0090 s with the exact and Verlet integrators.
+    within_reported_rounding_with_every_integrator(&scene, 0.01, 0.1);
 }
