@@ -164,11 +164,11 @@ pub(crate) fn touch_tolerance<T: Real, const D: usize>(x: &Vector<T, D>, r: T) -
 /// below that is lost and the contact is found at `s`, this far apart. In `f64` it is
 /// nothing (2e-12 m at 1e6 m/s with `h = 0.01`). In `f32` it is 1.2e-9 s for that step:
 /// two bodies at 3e4 m/s each are found in contact up to 7e-5 m apart, far beyond
-/// [`touch_tolerance`]. A
-/// 1 µg ball between two balls converging on it at 3e4 m/s, found in contact with each in
-/// turn at one `f32` instant 5e-6 m from both, was held against one at a time and sent
-/// into the other, 16,384 times: a false crush error (a fuzzed scene). A wedge's hold
-/// counts a gap within this reach as touching ([`time_resolved_gap`]).
+/// [`touch_tolerance`]. A 1 µg ball between two balls converging on it at 3e4 m/s, found
+/// in contact with each in turn at one `f32` instant about 5e-6 m from both, was held
+/// against one at a time and sent into the other, 16,384 times: a false crush error (a
+/// fuzzed scene). A wedge's hold counts a gap within this reach as touching
+/// ([`time_resolved_gap`]).
 pub(crate) fn time_rounding_reach<T: Real>(h: T, speed: T) -> T {
     T::EPSILON * h * speed
 }
