@@ -156,33 +156,26 @@ pub(crate) fn touch_tolerance<T: Real, const D: usize>(x: &Vector<T, D>, r: T) -
     T::lit(1e-9) * r + T::lit(16.0) * T::EPSILON * (x.amax() + r)
 }
 
-/// How far apart two bodies closing at up to `speed` (the sum of their speeds) can be
-/// when a time of impact finds them in contact at some in-step time of a step of `h`:
-/// what they close in one unit of that time's last place, at most `ε h`.
+/// A gap between bodies closing at up to `speed` (the sum of their speeds) as a wedge's
+/// hold takes it (`stack`; `h` the step's length, zero in another hold): none within
+/// what they close in one unit of the last place of an in-step time, `ε h speed`, and
+/// none below zero (an overlap is held as touching unless [`sunk`]).
 ///
 /// A time of impact is an in-step time `s + t`, rounded to the last place of `s`; a `t`
-/// below that is lost and the contact is found at `s`, this far apart. In `f64` it is
-/// nothing (2e-12 m at 1e6 m/s with `h = 0.01`). In `f32` it is 1.2e-9 s for that step:
-/// two bodies at 3e4 m/s each are found in contact up to 7e-5 m apart, far beyond
-/// [`touch_tolerance`]. A 1 µg ball between two balls converging on it at 3e4 m/s, found
-/// in contact with each in turn at one `f32` instant about 5e-6 m from both, was held
-/// against one at a time and sent into the other, 16,384 times: a false crush error (a
-/// fuzzed scene). A wedge's hold counts a gap within this reach as touching
-/// ([`time_resolved_gap`]).
-pub(crate) fn time_rounding_reach<T: Real>(h: T, speed: T) -> T {
-    T::EPSILON * h * speed
-}
-
-/// A gap between bodies closing at up to `speed` as a wedge's hold takes it (`stack`,
-/// `h` the step's length; another hold passes zero): none within
-/// [`time_rounding_reach`], where those contacts answer each other at one instant, and
-/// none below zero (an overlap is held as touching unless [`sunk`]).
+/// below that is lost and the contact is found at `s`, up to `ε h speed` apart. In `f64`
+/// that is nothing (2e-12 m at 1e6 m/s with `h = 0.01`). In `f32` the last place is
+/// 1.2e-9 s for that step: two bodies at 3e4 m/s each are found in contact up to 7e-5 m
+/// apart, far beyond [`touch_tolerance`]. A 1 µg ball between two balls converging on
+/// it at 3e4 m/s, found in contact with each in turn at one `f32` instant 4.7e-6 and
+/// 6.7e-6 m from them, was held against one at a time and sent into the other, 16,384
+/// times: a false crush error (a fuzzed scene). Taking both gaps for none, the hold
+/// holds both contacts at once.
 ///
 /// Other holds leave such a gap to the narrow phase, which finds it as a contact if it
 /// closes: counted as touching there too, the balls of a clump moving together at 7e4
 /// m/s in `f32` were held as one stack and sank 7e-3 m into each other (a fuzzed scene).
 pub(crate) fn time_resolved_gap<T: Real>(gap: T, h: T, speed: T) -> T {
-    if gap <= time_rounding_reach(h, speed) {
+    if gap <= T::EPSILON * h * speed {
         T::zero()
     } else {
         gap

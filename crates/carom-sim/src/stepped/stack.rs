@@ -960,7 +960,7 @@ where
         let tolerance = touch_tolerance(&p, r);
         let near = |gap: T, closing: T| gap <= tolerance || closing * rest > gap;
         // A wedge's hold takes a gap the time of impact cannot resolve for none.
-        let wedge_h = stack.wedge_step(self.h);
+        let (wedge_h, speed) = (stack.wedge_step(self.h), chord.norm());
         let centre = stack.parts[k].centre;
         let end = |n: &Vector<T, D>| End {
             part: k,
@@ -969,7 +969,7 @@ where
             lever: n * r,
         };
         self.for_each_surface(x, s, |target, n, v, gap| {
-            let gap = time_resolved_gap(gap, wedge_h, chord.norm() + v.norm());
+            let gap = time_resolved_gap(gap, wedge_h, speed + v.norm());
             if near(gap, (chord - v).dot(&n)) {
                 stack.rows.push(Row {
                     end: end(&n),
@@ -1014,7 +1014,7 @@ where
             let gap = if gap <= coordinate_resolution(p.amax().max(y.amax())) {
                 T::zero()
             } else {
-                time_resolved_gap(gap, wedge_h, chord.norm() + b.chord[j].norm())
+                time_resolved_gap(gap, wedge_h, speed + b.chord[j].norm())
             };
             if !near(gap, (chord - b.chord[j]).dot(&n)) {
                 continue;
