@@ -14,25 +14,27 @@ use crate::engine::BallStates;
 use crate::scene::Scene;
 
 /// Kinetic plus gravitational potential energy of the balls.
+///
+/// Computed in `f64` whatever `T` is, and rounded to `T` once: in `f32` the potential
+/// terms of a scene far from the origin are large and cancel, and a sum in `f32` adds
+/// up to a last place of the largest of them per ball to the states' own rounding. In
+/// `f64` it is the plain sum.
 pub fn energy<T: Real, const D: usize>(scene: &Scene<T, D>, states: &BallStates<T, D>) -> T
 where
     Const<D>: Space<T, D>,
 {
-    let half = T::lit(0.5);
-    let inertia = <Const<D> as Space<T, D>>::ball_inertia_factor();
-    let g = scene.world.gravity;
-    let mut e = T::zero();
+    let inertia = <Const<D> as Space<T, D>>::ball_inertia_factor().to_f64();
+    let g = scene.world.gravity.map(T::to_f64);
+    let mut e = 0.0_f64;
     for (k, b) in scene.balls.iter().enumerate() {
+        let (m, r) = (b.mass.to_f64(), b.radius.to_f64());
         let spin = &states.spin[k];
-        let rotation = inertia
-            * b.mass
-            * b.radius
-            * b.radius
-            * <Const<D> as Space<T, D>>::angular_dot(spin, spin);
-        e += half * b.mass * states.vel[k].norm_squared() + half * rotation
-            - b.mass * g.dot(&states.pos[k]);
+        let rotation =
+            inertia * m * r * r * <Const<D> as Space<T, D>>::angular_dot(spin, spin).to_f64();
+        let (v, x) = (states.vel[k].map(T::to_f64), states.pos[k].map(T::to_f64));
+        e += 0.5 * m * v.norm_squared() + 0.5 * rotation - m * g.dot(&x);
     }
-    e
+    T::lit(e)
 }
 
 /// Total linear momentum `Σ m v`.
@@ -90,6 +92,28 @@ mod tests {
             state_hash(&states),
             state_hash(&moved),
             "one ulp changes the hash"
+        );
+    }
+
+    /// Two 1 kg balls 5e4 m above and below the origin in `f32`: their potential terms
+    /// (±490,500 J, a last place of 0.03 J) cancel, and the energy is the kinetic 0.01 J,
+    /// to `f32`'s rounding of that (a sum in `f32` gave 0).
+    #[test]
+    fn energy_in_f32_far_from_the_origin_keeps_the_small_terms() {
+        let mut s = classic::head_on(1.0, 1.0, 0.1, 0.0, 0.0)
+            .cast::<f32>()
+            .unwrap();
+        s.world.gravity = Vector2::new(0.0, -9.81);
+        let states = BallStates {
+            pos: vec![Vector2::new(0.0, 5e4), Vector2::new(0.0, -5e4)],
+            vel: vec![Vector2::new(0.1, 0.0), Vector2::new(-0.1, 0.0)],
+            spin: vec![Vector1::new(0.0); 2],
+        };
+        let expected = 0.5 * 1.0 * 0.1_f64.powi(2) * 2.0;
+        let e = f64::from(energy(&s, &states));
+        assert!(
+            (e - expected).abs() <= 2.0 * f64::from(f32::EPSILON) * expected,
+            "{e} J, expected {expected} J"
         );
     }
 }

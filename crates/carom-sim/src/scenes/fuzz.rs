@@ -178,7 +178,10 @@ where
     /// The checks of the states at time `t` of a run with steps of `dt` (0 for the
     /// event-driven engine), the samples taken in time order. The energy may rise by
     /// `Σm |g|² dt t`, a first-order scheme's truncation under gravity (explicit Euler
-    /// gains `m g² dt²/2` per step in free flight).
+    /// gains `m g² dt²/2` per step in free flight), plus `Σm |g| ε max|x|`, the rounding
+    /// of the states' positions along gravity (the engine computes from the scene's
+    /// middle and hands positions back rounded to the precision at their place: 5e4 m
+    /// out in `f32`, 3.9e-3 m).
     pub fn sample<T: Real>(
         &mut self,
         scene: &Scene<T, D>,
@@ -237,7 +240,8 @@ where
             self.start_energy = None;
         }
         sample.energy_rise = self.start_energy.zip(hidden).map(|(start, hidden)| {
-            let allowed = self.mass * self.gravity_squared * dt * t;
+            let g = self.gravity_squared.sqrt();
+            let allowed = self.mass * g * (g * dt * t + self.resolution);
             (energy(scene, states).to_f64() + hidden - start - allowed) / self.energy_scale
         });
         sample
@@ -625,6 +629,41 @@ mod tests {
         // The exact integrator keeps the energy to rounding; the report is the rise less
         // the first-order allowance, so at most rounding above zero.
         assert!(rise < 1e-12, "rise {rise}");
+    }
+
+    /// A 2 kg ball at rest 5e4 m up in `f32`, where a coordinate's last place is 3.9e-3
+    /// m and the resolution `ε max|x|` 6.0e-3 m: handed back one last place higher (the
+    /// rounding of a position computed from the scene's middle), it shows no energy
+    /// rise; two resolutions higher, a rise.
+    #[test]
+    fn a_position_rounded_far_out_is_no_energy_rise_and_a_real_rise_is() {
+        let text = "dim = 2\n[world]\ngravity = [0.0, -9.81]\n[[balls]]\n\
+                    pos = [0.0, 50000.0]\nvel = [0.0, 0.0]\nradius = 0.05\nmass = 2.0\n";
+        let LoadedScene::D2(scene) = parse_scene(text).unwrap() else {
+            unreachable!()
+        };
+        let scene = scene.cast::<f32>().unwrap();
+        let start = BallStates {
+            pos: vec![scene.balls[0].pos],
+            vel: vec![scene.balls[0].vel],
+            spin: vec![nalgebra::Vector1::new(0.0)],
+        };
+        let mut invariants = Invariants::new(&scene, &start);
+        let rise_at = |invariants: &mut Invariants<2>, up: f32| {
+            let mut now = start.clone();
+            now.pos[0].y += up;
+            invariants
+                .sample(&scene, &now, 0.0, 0.0)
+                .energy_rise
+                .unwrap()
+        };
+        let last_place = 5e4_f32.next_up() - 5e4;
+        let scale = invariants.energy_scale;
+        let rounded = rise_at(&mut invariants, last_place);
+        assert!(rounded <= 0.0, "one last place up: rise {rounded:e}");
+        let resolution = invariants.resolution() as f32;
+        let real = rise_at(&mut invariants, 2.0 * resolution);
+        assert!(real > 0.0, "two resolutions up: rise {real:e} of {scale} J");
     }
 
     #[test]
