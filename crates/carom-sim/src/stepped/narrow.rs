@@ -51,7 +51,7 @@ use crate::scene::coordinate_resolution;
 /// [`Allowance`]).
 const APPROACH_ROUNDING: f64 = 64.0;
 
-/// The same for two [`sunk`] balls, which holds leave receding (see [`Allowance`]).
+/// The same for a ball [`sunk`] into another ball or into a box (see [`Allowance`]).
 const SUNK_APPROACH_ROUNDING: f64 = 4.0;
 
 /// What a ball touches.
@@ -294,7 +294,10 @@ pub(crate) struct Overflow {
 /// sunk into a box is allowed the same (`Narrow::sunk_in_box`: deeper than the floor
 /// over a step plus the rounding of the ball's and the box's coordinates): a ball riding
 /// a kinematic box at 1e6 m/s in `f64`, closing on its face at `32 ε` of the two
-/// speeds, sank 1.3e-8 m into it in 0.9 s, and on for good.
+/// speeds, sank 1.3e-8 m into it in 0.9 s, and on for good. A hold does not aim a ball
+/// apart from a box, only stops its approach; that this does not turn into a contact
+/// found again and again at one instant is measured, not derived: no outcome of six
+/// fuzz campaigns (2,520 runs) changed with it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Allowance<T: Real, const D: usize> {
     /// Contacts approaching slower than this are not events: the part of the floor
