@@ -16,9 +16,9 @@ use crate::scene::Scene;
 /// Kinetic plus gravitational potential energy of the balls.
 ///
 /// Computed in `f64` whatever `T` is, and rounded to `T` once: in `f32` the potential
-/// terms of a scene far from the origin are large and cancel, and a sum in `f32` adds
-/// up to a last place of the largest of them per ball to the states' own rounding. In
-/// `f64` it is the plain sum.
+/// terms of a scene far from the origin are large and cancel, and each addition in
+/// `f32` rounds to the last place of a running sum that holds them, which can be all
+/// of the rest (test below: 0 J for 0.01 J). In `f64` it is the plain sum.
 pub fn energy<T: Real, const D: usize>(scene: &Scene<T, D>, states: &BallStates<T, D>) -> T
 where
     Const<D>: Space<T, D>,

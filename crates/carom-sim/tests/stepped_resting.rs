@@ -398,6 +398,13 @@ fn a_ball_on_the_floor_pushed_in_by_a_light_ball_sinks_no_more_than_the_narrow_p
     }
 }
 
+/// The gap within which the engine counts a ball of radius `r` at coordinates up to `x`
+/// as touching, in a precision of machine epsilon `eps`: `1e-9 r + 16 eps (x + r)`, the
+/// engine's documented touch tolerance, restated here as the bound the tests hold it to.
+fn touch_tolerance(eps: f64, x: f64, r: f64) -> f64 {
+    1e-9 * r + 16.0 * eps * (x + r)
+}
+
 /// Two balls rolling side by side on the floor, the one behind faster by 6.7e-8 m/s
 /// (the third campaign's s20 reduced to its two balls, 5e4 m from the origin; here also
 /// near it). That is slower than the floor under which the narrow phase answers no
@@ -427,8 +434,7 @@ fn balls_rolling_side_by_side_closing_slower_than_the_resting_floor_do_not_sink_
             ],
             ..Scene::default()
         };
-        let rounding = |x: f64| 1e-9 * r + 16.0 * f64::EPSILON * (x + r);
-        let floor_depth = 1e-6 * G * dt * dt + 2.0 * rounding(x0 + 1.0);
+        let floor_depth = 1e-6 * G * dt * dt + 2.0 * touch_tolerance(f64::EPSILON, x0 + 1.0, r);
         let allowed = 2.0 * floor_depth + faster * dt;
         let s = if own_coordinates {
             spanning_the_origin(&near)
@@ -493,8 +499,7 @@ fn assert_moving_together_does_not_sink<T: carom_math::Real>(half_width: f64, on
         ..Scene::default()
     };
     let eps = T::EPSILON.to_f64();
-    let tolerance = 1e-9 * r + 16.0 * eps * (half_width + r);
-    let allowed = 2.0 * tolerance + closing * dt;
+    let allowed = 2.0 * touch_tolerance(eps, half_width, r) + closing * dt;
     common::each_step(&scene, dt, steps, |integrator, k, sim| {
         let states = states(sim);
         let depth = if on_a_box {

@@ -68,7 +68,7 @@ where
     border: Option<(Vector<f64, D>, Vector<f64, D>, bool)>,
     resolution: f64,
     mass: f64,
-    gravity_squared: f64,
+    gravity: f64,
     energy_scale: f64,
     start_energy: Option<f64>,
     /// In a periodic border under gravity, where the balls are in the unbounded space
@@ -161,7 +161,7 @@ where
                 .map(|b| (wide(&b.border.min()), wide(&b.border.max()), b.periodic)),
             resolution: T::EPSILON.to_f64() * largest,
             mass,
-            gravity_squared: g * g,
+            gravity: g,
             // Kinetic energy plus the potential energy over the border's height: the scale
             // a relative rise is measured against (the start's total may be near zero).
             energy_scale: (speed_energy + mass * g * extent).max(f64::MIN_POSITIVE),
@@ -240,7 +240,7 @@ where
             self.start_energy = None;
         }
         sample.energy_rise = self.start_energy.zip(hidden).map(|(start, hidden)| {
-            let g = self.gravity_squared.sqrt();
+            let g = self.gravity;
             let allowed = self.mass * g * (g * dt * t + self.resolution);
             (energy(scene, states).to_f64() + hidden - start - allowed) / self.energy_scale
         });

@@ -291,7 +291,7 @@ pub(crate) struct Overflow {
 /// on for good: two balls falling side by side at 4.65 m/s in `f32`, closing at 6.9e-5
 /// m/s (under the 7.1e-5 m/s of `64 ε`), sank 6.9e-7 m a step, to 5.7e-6 m (a fuzzed
 /// scene); now they stop at the sunk depth plus a step's closing, 4.2e-6 m. A ball
-/// sunk into a box is allowed the same (`Narrow::sunk_in_box`: deeper than the floor
+/// sunk into a box is allowed the same (`Narrow::sunk`: deeper than the floor
 /// over a step plus the rounding of the ball's and the box's coordinates): a ball riding
 /// a kinematic box at 1e6 m/s in `f64`, closing on its face at `32 ε` of the two
 /// speeds, sank 1.3e-8 m into it in 0.9 s, and on for good. A hold does not aim a ball
@@ -433,28 +433,32 @@ where
         approach <= (self.allowance).of(self.balls, ball, target, u, other_velocity, normal)
     }
 
-    /// Whether balls `i` and `j` (j's position shifted by `shift`) are [`sunk`] at `s`.
-    fn sunk(&self, i: usize, j: usize, s: T, shift: &Vector<T, D>) -> bool {
+    /// Whether ball `i` is sunk into `target` (its image shifted by `shift`) at `s`:
+    /// deeper than the floor lets a contact sink in a step, plus the rounding of both
+    /// bodies' coordinates ([`sunk`] for a ball; for a box, the box taken as a point at
+    /// its centre in [`Allowance::sunk_depth`]). Never into a wall, whose allowance
+    /// counts no speeds.
+    fn sunk(&self, i: usize, target: Target, s: T, shift: &Vector<T, D>) -> bool {
         let b = self.balls;
-        let (x, y) = (b.position_at(i, s), b.position_at(j, s) + shift);
-        sunk(&self.allowance, (&x, b.radius[i]), (&y, b.radius[j])).is_some()
-    }
-
-    /// Whether ball `i` is sunk into box `k` (its image shifted by `shift`) at `s`:
-    /// deeper than the floor lets a contact sink in a step, plus the rounding of the
-    /// ball's and the box's coordinates (`Allowance::sunk_depth`, the box taken as a
-    /// point at its centre).
-    fn sunk_in_box(&self, i: usize, k: usize, s: T, shift: &Vector<T, D>) -> bool {
-        let (x, r) = (self.balls.position_at(i, s), self.balls.radius[i]);
-        let obb = self.boxes.at(k, s).translated(shift);
-        let depth = -signed_distance(&Ball::new_unchecked(x, r), &obb);
-        depth > (self.allowance).sunk_depth(&x, r, &obb.center(), T::zero())
+        let (x, r) = (b.position_at(i, s), b.radius[i]);
+        match target {
+            Target::Ball(j) => {
+                let (y, q) = (b.position_at(j as usize, s) + shift, b.radius[j as usize]);
+                sunk(&self.allowance, (&x, r), (&y, q)).is_some()
+            }
+            Target::Box(k) => {
+                let obb = self.boxes.at(k as usize, s).translated(shift);
+                let depth = -signed_distance(&Ball::new_unchecked(x, r), &obb);
+                depth > (self.allowance).sunk_depth(&x, r, &obb.center(), T::zero())
+            }
+            Target::Border => false,
+        }
     }
 
     /// Turns a time of impact into an event, or `None` if it is no contact worth acting
     /// on: approaching no faster than the contact's [`Allowance`], or, for a ball
     /// overlapping another ball or a box deeper than the floor lets it sink
-    /// ([`Self::sunk`], [`Self::sunk_in_box`]), than its rounding.
+    /// ([`Self::sunk`]), than its rounding.
     #[allow(clippy::too_many_arguments)]
     fn event<F>(
         &self,
@@ -484,19 +488,11 @@ where
         if approach <= allowance.of(self.balls, ball, target, u, other_velocity, &toi.normal) {
             // Within the floor: no contact, but for a pair sunk deeper than it lets a
             // contact sink, which is allowed only rounding (checked last: rarely needed).
-            let beyond_rounding = || {
-                let units = SUNK_APPROACH_ROUNDING;
-                approach > allowance.rounding(self.balls, ball, target, u, other_velocity, units)
-            };
-            let sunk = match (toi.status, target) {
-                (Status::AlreadyTouching, Target::Ball(j)) => {
-                    beyond_rounding() && self.sunk(ball, j as usize, s, &shift)
-                }
-                (Status::AlreadyTouching, Target::Box(k)) => {
-                    beyond_rounding() && self.sunk_in_box(ball, k as usize, s, &shift)
-                }
-                _ => false,
-            };
+            let units = SUNK_APPROACH_ROUNDING;
+            let sunk = toi.status == Status::AlreadyTouching
+                && approach
+                    > allowance.rounding(self.balls, ball, target, u, other_velocity, units)
+                && self.sunk(ball, target, s, &shift);
             if !sunk {
                 return Ok(None);
             }
