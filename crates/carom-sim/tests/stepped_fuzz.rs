@@ -13,9 +13,9 @@
 //! step too long for the scene's drag. In `f32` the states must stay finite, the errors
 //! named, and no excursion may exceed 64 units of the coordinates' resolution
 //! `ε max|x|` (`Invariants::resolution`): a net for gross faults, not a measure of
-//! `f32`'s rounding. Campaigns of other seeds reach 47 units near the origin (5.7e-6 m,
-//! open in docs/stepped.md); the two scenes below bound their runs to the rounding of
-//! the reported positions.
+//! `f32`'s rounding. Campaigns of other seeds reach 35 units near the origin (4.2e-6 m:
+//! two touch tolerances and a step's closing, see docs/stepped.md); the scenes below
+//! bound their runs to the rounding of the reported positions.
 //!
 //! Three scenes campaigns found, reduced, are run on their own below, in `f32`: 5e4 m
 //! from the origin, a ball too slow for its coordinates under a moving box, and a pair
