@@ -579,6 +579,23 @@ fn a_light_ball_struck_into_a_wall_at_a_slant_by_a_heavy_ball_is_not_taken_for_c
     }
 }
 
+/// A 4.4 kg ball driven into the right wall by a 104 t ball, a 1.9 t ball in the corner
+/// below, under gravity (a fuzzed scene's state on a diverted path). In its one step the
+/// light ball takes about 17,000 contacts; within each simultaneity instant they are
+/// answered bottom-up, so it met the heavy balls before the wall and moved into the wall
+/// by a few 1e-10 m each time, 7.3e-8 m in all, where the wedge's hold stopped its
+/// approach and left it. A hold now aims a ball sunk into a surface deeper than the
+/// floor lets a contact sink out of it over the rest of the step. One step, every
+/// integrator: no ball outside the border or overlapping beyond 1e-9 m.
+const LIGHT_BALL_RATCHETED_INTO_A_WALL: &str =
+    include_str!("scenes/light_ball_ratcheted_into_a_wall_by_a_heavy_ball.toml");
+
+#[test]
+fn a_light_ball_ratcheted_into_a_wall_by_a_heavy_ball_is_held_out_of_it() {
+    let s = scene_2d(LIGHT_BALL_RATCHETED_INTO_A_WALL);
+    assert_runs_apart_and_inside(&s, &Integrator::ALL, 0.01, "f64", 1e-9);
+}
+
 /// The fourth campaign's s29 in `f32` (32 balls, two boxes, drag): a 1.4 mg ball in the
 /// lower right corner is wedged at a slant by a ball 1.8e8 times heavier. Its three
 /// rows on two degrees of freedom are independent only through the heavy ball's `1/m`,

@@ -57,8 +57,9 @@
 //! contacts (a contact pushes only where its chords close exactly at its margin): the
 //! hold never adds energy, to first order in the rotation, but where a margin is
 //! negative: two balls sunk into each other deeper than the narrow phase's
-//! floor lets a contact sink (`narrow::sunk`) are aimed apart at their depth over the
-//! rest of the step (`−g/τ`), and the push that does it adds `2 λ |g|/τ`. The impacts are
+//! floor lets a contact sink (`narrow::sunk`), or a ball sunk so into a wall or a box,
+//! are aimed apart at their depth over the rest of the step (`−g/τ`), and the push that
+//! does it adds `2 λ |g|/τ`. The impacts are
 //! inelastic impulses at `s`, which only take energy.
 
 use carom_geometry::Ball;
@@ -69,7 +70,7 @@ use nalgebra::Const;
 use carom_response::RigidCluster;
 
 use super::clusters::{FREE, Flight, Motion};
-use super::narrow::{Target, sunk, time_resolved_gap, touch_tolerance};
+use super::narrow::{Allowance, Target, sunk, time_resolved_gap, touch_tolerance};
 use super::response::{Contacts, Effect};
 use super::stick::Side;
 use super::sweep::path_box;
@@ -968,15 +969,16 @@ where
             arm: p + n * r - centre,
             lever: n * r,
         };
+        let allowance = self.rules.allowance(self.h);
         self.for_each_surface(x, s, |target, n, v, gap| {
-            let gap = time_resolved_gap(gap, wedge_h, speed + v.norm());
-            if near(gap, (chord - v).dot(&n)) {
+            let held_gap = held_surface_gap(&allowance, (&p, r), gap, wedge_h, speed + v.norm());
+            if near(held_gap, (chord - v).dot(&n)) {
                 stack.rows.push(Row {
                     end: end(&n),
                     other: Other::Surface(v),
                     target,
                     normal: n,
-                    gap: gap.max(T::zero()),
+                    gap: held_gap,
                 });
             }
         });
@@ -987,7 +989,6 @@ where
         candidates.dedup();
         let n_balls = self.balls.len();
         let cluster_body = matches!(stack.parts[k].side, Side::Cluster(_));
-        let allowance = self.rules.allowance(self.h);
         for &j in &candidates {
             let j = j as usize;
             if j >= n_balls || j == x || self.side(j) == self.side(x) {
@@ -1412,5 +1413,31 @@ where
                 }
             }
         }
+    }
+}
+
+/// The gap a hold keeps between a ball (centre and radius) and a surface, given their
+/// `gap` (negative when overlapping): none in a wedge's hold where the in-step time
+/// cannot resolve it at their `speed` ([`time_resolved_gap`]), none when overlapping,
+/// but the (negative) gap itself for a ball sunk into the surface deeper than the floor
+/// lets a contact sink ([`Allowance::sunk_depth`], the surface's rounding taken where
+/// the ball is, which the ball's own touch tolerance covers): such a ball is aimed out
+/// over the rest of the step, as a sunk pair is aimed apart. Only stopping its approach
+/// left a wedged ball where a chain of contacts had ratcheted it, 7.3e-8 m into a wall
+/// (docs/stepped.md).
+fn held_surface_gap<T: Real, const D: usize>(
+    allowance: &Allowance<T, D>,
+    (x, r): (&Vector<T, D>, T),
+    gap: T,
+    wedge_h: T,
+    speed: T,
+) -> T
+where
+    Const<D>: Space<T, D>,
+{
+    if -gap > allowance.sunk_depth(x, r, x, T::zero()) {
+        gap
+    } else {
+        time_resolved_gap(gap, wedge_h, speed).max(T::zero())
     }
 }
