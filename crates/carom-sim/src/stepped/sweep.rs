@@ -24,8 +24,8 @@
 //! escaped reads its **partner list** (the pairs, turned into per-ball lists at each
 //! build): a ball that can touch its path has its own path in its entry, which then meets
 //! this ball's entry, or is an escapee; a prediction for an escapee queries the broad
-//! phase with its path box. Both scan the escapees (in a periodic domain with the path's
-//! periodic images too), so no pair that can touch is missed. When
+//! phase with its path box. Both scan the escapees (in a periodic domain through its faces
+//! too, see `escapees`), so no pair that can touch is missed. When
 //! the list grows past a bound (a sixteenth of the balls, at least 64), the broad phase is
 //! rebuilt: at the start of a step, or mid-step by ending the window at the current time
 //! (bounded work; see `StepStats::windows` and `StepStats::rebuilds`).
@@ -78,8 +78,6 @@ pub(crate) struct Sweep<T: Real, const D: usize> {
     partners: Vec<u32>,
     /// The balls whose paths left their entries.
     escapees: Escapees<T, D>,
-    /// The periodic domain, if any: escapees are looked up with the query's images.
-    periodic: Option<Border<T, D>>,
 }
 
 impl<T: Real, const D: usize> Sweep<T, D>
@@ -111,8 +109,7 @@ where
             pairs: Vec::new(),
             partner_start: Vec::with_capacity(n + 1),
             partners: Vec::new(),
-            escapees: Escapees::new(n),
-            periodic: periodic.copied(),
+            escapees: Escapees::new(n, periodic.map(Border::period)),
         }
     }
 
@@ -376,57 +373,7 @@ where
         } else {
             self.phase.query_aabb(path, out);
         }
-        self.escapees_meeting(path, out);
-    }
-
-    /// Appends the escapees whose boxes meet `path`, in a periodic domain any periodic
-    /// image of it. Paths are shorter than a quarter of the period (see
-    /// `periodic_reach`) and start in the cell, so along each axis an image one period
-    /// up can meet a box only for a path starting in the lower half of the cell, one
-    /// period down only for one ending in the upper half. Without this, a ball near one
-    /// side of the cell missed an escapee near the other: a fuzzed pair met through
-    /// the boundary after one of them had escaped, and sank 1.5e-3 m into each other.
-    fn escapees_meeting(&self, path: &Aabb<T, D>, out: &mut Vec<u32>) {
-        let Some(border) = &self.periodic else {
-            self.escapees.meeting(path, out);
-            return;
-        };
-        if self.escapees.balls().is_empty() {
-            return;
-        }
-        let (lo, hi, size) = (border.min(), border.max(), border.extents());
-        let middle = (lo + hi) * T::lit(0.5);
-        // Per axis the shifts worth trying: 0, and +size and/or −size.
-        let shifts = |k: usize| {
-            [
-                Some(T::zero()),
-                (path.min()[k] < middle[k]).then_some(size[k]),
-                (path.max()[k] > middle[k]).then_some(-size[k]),
-            ]
-        };
-        let mut shift = Vector::<T, D>::zeros();
-        self.images(path, 0, &shifts, &mut shift, out);
-    }
-
-    /// Looks up every image of `path` shifted by one of `shifts(k)` along each axis
-    /// `k >= axis` (and by `shift` along the axes before).
-    fn images(
-        &self,
-        path: &Aabb<T, D>,
-        axis: usize,
-        shifts: &dyn Fn(usize) -> [Option<T>; 3],
-        shift: &mut Vector<T, D>,
-        out: &mut Vec<u32>,
-    ) {
-        if axis == D {
-            let image = Aabb::new_unchecked(path.min() + *shift, path.max() + *shift);
-            self.escapees.meeting(&image, out);
-            return;
-        }
-        for s in shifts(axis).into_iter().flatten() {
-            shift[axis] = s;
-            self.images(path, axis + 1, shifts, shift, out);
-        }
+        self.escapees.meeting(path, out);
     }
 }
 
@@ -641,8 +588,9 @@ mod tests {
     }
 
     /// In a periodic domain the escapees a path meets through the boundary are
-    /// candidates too: balls whose paths leave the top of the cell are found by the
-    /// balls at its bottom.
+    /// candidates too: balls whose paths leave the cell through its top (or its right
+    /// face, the axis the escapees' lanes slice) are found by the balls at its bottom
+    /// (its left face).
     #[test]
     fn in_a_periodic_domain_candidates_hold_the_escapees_a_path_meets_through_the_boundary() {
         let scene = gas::<2>(&GasParams {
@@ -660,17 +608,6 @@ mod tests {
             balls.seg_x[i] = balls.pos[i];
             balls.chord[i] = balls.vel[i];
         }
-        let mut sweep = Sweep::new(BroadChoice::Grid, balls.len(), Some(&border));
-        sweep.build(&balls, &BoxArrays::new(&[], 1.0), 0.0, 0.2, false);
-        // The balls between four and five metres below the top escape: their paths now
-        // reach 5 m up, out through the top, far from their entries.
-        let escapees: Vec<usize> = (0..balls.len())
-            .filter(|&i| (4.0..5.0).contains(&(hi[1] - balls.pos[i][1])))
-            .collect();
-        for &e in &escapees {
-            let x = balls.pos[e];
-            sweep.moved(e, path_box(&x, &(x + Vector::from([0.0, 5.0])), 0.5));
-        }
         // Every periodic image of `a` tested against `b`, by brute force.
         let meet = |a: &Aabb<f64, 2>, b: &Aabb<f64, 2>| {
             [-1.0, 0.0, 1.0].iter().any(|&kx| {
@@ -680,18 +617,39 @@ mod tests {
                 })
             })
         };
-        let mut out = Vec::new();
-        let mut through_the_boundary = 0;
-        for i in (0..balls.len()).filter(|&i| balls.pos[i][1] < lo[1] + 2.0) {
-            let path = reach_box(&balls.pos[i], balls.radius[i], 0.1);
-            sweep.candidates(i, &path, &mut out);
+        for axis in [1, 0] {
+            let mut sweep = Sweep::new(BroadChoice::Grid, balls.len(), Some(&border));
+            sweep.build(&balls, &BoxArrays::new(&[], 1.0), 0.0, 0.2, false);
+            // The balls between four and five metres inside the upper face escape: their
+            // paths now reach 5 m out through it, far from their entries.
+            let escapees: Vec<usize> = (0..balls.len())
+                .filter(|&i| (4.0..5.0).contains(&(hi[axis] - balls.pos[i][axis])))
+                .collect();
+            let mut out_through = Vector::zeros();
+            out_through[axis] = 5.0;
             for &e in &escapees {
-                if meet(&path, sweep.box_of(e)) {
-                    through_the_boundary += 1;
-                    assert!(out.contains(&(e as u32)), "ball {i} misses escapee {e}");
+                let x = balls.pos[e];
+                sweep.moved(e, path_box(&x, &(x + out_through), 0.5));
+            }
+            let mut out = Vec::new();
+            let mut through_the_boundary = 0;
+            for i in (0..balls.len()).filter(|&i| balls.pos[i][axis] < lo[axis] + 2.0) {
+                let path = reach_box(&balls.pos[i], balls.radius[i], 0.1);
+                sweep.candidates(i, &path, &mut out);
+                for &e in &escapees {
+                    if meet(&path, sweep.box_of(e)) {
+                        through_the_boundary += 1;
+                        assert!(
+                            out.contains(&(e as u32)),
+                            "axis {axis}: ball {i} misses escapee {e}"
+                        );
+                    }
                 }
             }
+            assert!(
+                through_the_boundary > 10,
+                "axis {axis}: {through_the_boundary} meetings"
+            );
         }
-        assert!(through_the_boundary > 10, "{through_the_boundary} meetings");
     }
 }
