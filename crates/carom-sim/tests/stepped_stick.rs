@@ -650,6 +650,40 @@ fn f32_runs_stick_and_keep_the_pair_rigid_to_single_precision() {
     assert!(gap <= 1e-5, "member distance drift {gap} m");
 }
 
+/// A stuck pair sliding along the top wall and turning one member slowly into it, in
+/// `f32` (see the scene's comment). Only rounding is allowed the approach of a member
+/// sunk into a wall deeper than the floor lets a contact sink, not the rounding of its
+/// chord: the wall takes it, and it ends no deeper than that sunk depth (7.6e-6 m here)
+/// plus one step's closing (6.9e-6 m): 2e-5 m is asserted (it was 7.4e-4 m). The same
+/// pair in `f64`, where the chord's rounding is 1.4e-12 m/s, meets the wall as well
+/// and stays inside it.
+const STUCK_PAIR_TURNING_INTO_A_WALL: &str =
+    include_str!("scenes/stuck_pair_turning_into_a_wall_in_f32.toml");
+
+fn assert_turned_back_by_the_wall<T: carom_math::Real>(s: &Scene<T, 2>, tolerance: f64) {
+    for integrator in Integrator::ALL {
+        let mut sim = stepped(s, integrator, 0.01);
+        let mut rec = Recorder::default();
+        sim.advance_to(T::lit(2.0), &mut rec)
+            .unwrap_or_else(|e| panic!("{integrator}: {e}"));
+        let outside = outside_border(s, &states(&sim));
+        let walls = (rec.collisions.iter())
+            .filter(|c| matches!(c, Collision::BallBorder { i: 0, .. }))
+            .count();
+        assert!(
+            outside <= tolerance && walls >= 1,
+            "{integrator}: {outside:e} m outside, {walls} contacts with the wall"
+        );
+    }
+}
+
+#[test]
+fn a_stuck_pair_turning_slowly_into_a_wall_in_f32_is_turned_back_by_it() {
+    let s = scene_2d(STUCK_PAIR_TURNING_INTO_A_WALL);
+    assert_turned_back_by_the_wall(&s.cast::<f32>().unwrap(), 2e-5);
+    assert_turned_back_by_the_wall(&s, 1e-12);
+}
+
 #[test]
 fn a_spinning_cluster_wraps_around_a_periodic_border_as_a_whole() {
     // The stuck pair drifts left at 0.56 m/s through a periodic box 2 m wide: it crosses

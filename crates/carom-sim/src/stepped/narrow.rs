@@ -51,7 +51,8 @@ use crate::scene::coordinate_resolution;
 /// [`Allowance`]).
 const APPROACH_ROUNDING: f64 = 64.0;
 
-/// The same for a ball [`sunk`] into another ball or into a box (see [`Allowance`]).
+/// The same for a ball [`sunk`] into another ball or a box (see [`Allowance`]; a wall
+/// counts no speeds).
 const SUNK_APPROACH_ROUNDING: f64 = 4.0;
 
 /// What a ball touches.
@@ -263,7 +264,16 @@ pub(crate) struct Overflow {
 /// which counts for it against a wall too. A cluster held against the floor in a scene
 /// without gravity (no resting floor) was left closing on it at 4.4e-12 m/s, 145 units
 /// of its coordinates' last place over the rest of the step, and found again 16,384
-/// times: a false crush error.
+/// times: a false crush error. That is an allowance for one step, not for good: a
+/// member sunk into a wall, a box or a ball deeper than the floor lets a contact sink is
+/// allowed only the rounding of the velocities ([`Allowance::sunk_rounding`]), not its
+/// chord's. A stuck pair sliding along a wall in `f32`, turning one member into it at
+/// 6.9e-4 m/s, under the 7.6e-4 m/s of `2ρ/τ` there, sank 7.4e-4 m into it in 2 s (a
+/// fuzzed scene's pair did the same in a corner); now the wall takes it at the sunk depth
+/// plus a step's closing, 1.5e-5 m. A hold aims such a member out by more than its
+/// chord's rounding: its depth over the rest of the step, where the depth is beyond the
+/// touch tolerance, `16 ε` of its coordinates, and the chord's rounding is `2ρ = 16 ε` of
+/// them over the same time.
 ///
 /// The resting floor holds a wall's contact only as far as gravity presses a ball into
 /// it, `|n·ĝ|` of it: a ball sliding down a side wall drifting out at 9.1e-8 m/s, below
@@ -291,13 +301,13 @@ pub(crate) struct Overflow {
 /// on for good: two balls falling side by side at 4.65 m/s in `f32`, closing at 6.9e-5
 /// m/s (under the 7.1e-5 m/s of `64 ε`), sank 6.9e-7 m a step, to 5.7e-6 m (a fuzzed
 /// scene); now they stop at the sunk depth plus a step's closing, 4.2e-6 m. A ball
-/// sunk into a box is allowed the same (`Narrow::sunk`: deeper than the floor
-/// over a step plus the rounding of the ball's and the box's coordinates): a ball riding
-/// a kinematic box at 1e6 m/s in `f64`, closing on its face at `32 ε` of the two
-/// speeds, sank 1.3e-8 m into it in 0.9 s, and on for good. A hold does not aim a ball
-/// apart from a box, only stops its approach; that this does not turn into a contact
-/// found again and again at one instant is measured, not derived: no outcome of six
-/// fuzz campaigns (2,520 runs) changed with it.
+/// sunk into a box or a wall is allowed the same (`Narrow::sunk`: deeper than the floor
+/// over a step plus the rounding of the ball's and the box's coordinates; a wall's
+/// approach counts no speeds, so there only a cluster member's chord was allowed, and
+/// is no longer): a ball riding a kinematic box at 1e6 m/s in `f64`, closing on its
+/// face at `32 ε` of the two speeds, sank 1.3e-8 m into it in 0.9 s, and on for good. A
+/// hold aims a ball sunk into a box or a wall out of it over the rest of the step
+/// (`stack::held_surface_gap`).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Allowance<T: Real, const D: usize> {
     /// Contacts approaching slower than this are not events: the part of the floor
@@ -345,6 +355,40 @@ where
         other_velocity: &Vector<T, D>,
         units: f64,
     ) -> T {
+        let chords = match target {
+            Target::Ball(j) => {
+                self.member_chord(balls, ball) + self.member_chord(balls, j as usize)
+            }
+            Target::Box(_) | Target::Border => self.member_chord(balls, ball),
+        };
+        Self::velocity_rounding(balls, ball, target, u, other_velocity, units) + chords
+    }
+
+    /// The rounding a [`Narrow::sunk`] contact's approach is allowed: `4 ε` of the two
+    /// speeds and the turn of a pair's normal, not a cluster member's chord (see the
+    /// type's documentation).
+    pub(crate) fn sunk_rounding(
+        balls: &BallArrays<T, D>,
+        ball: usize,
+        target: Target,
+        u: &Vector<T, D>,
+        other_velocity: &Vector<T, D>,
+    ) -> T {
+        let units = SUNK_APPROACH_ROUNDING;
+        Self::velocity_rounding(balls, ball, target, u, other_velocity, units)
+    }
+
+    /// The rounding of the velocities an approach is computed from: `units` units of `ε`
+    /// of the two speeds (none for a wall) and, for two balls, the turn of the normal
+    /// between their centres.
+    fn velocity_rounding(
+        balls: &BallArrays<T, D>,
+        ball: usize,
+        target: Target,
+        u: &Vector<T, D>,
+        other_velocity: &Vector<T, D>,
+        units: f64,
+    ) -> T {
         let speeds = T::lit(units) * T::EPSILON * (u.norm() + other_velocity.norm());
         match target {
             Target::Ball(j) => {
@@ -352,13 +396,10 @@ where
                 // The normal's direction, known to `ρ / d` (see the type's documentation).
                 let angle = coordinate_resolution(balls.seg_x[ball].amax())
                     / (balls.radius[ball] + balls.radius[j]);
-                speeds
-                    + (u - other_velocity).norm() * angle
-                    + self.member_chord(balls, ball)
-                    + self.member_chord(balls, j)
+                speeds + (u - other_velocity).norm() * angle
             }
-            Target::Box(_) => speeds + self.member_chord(balls, ball),
-            Target::Border => self.member_chord(balls, ball),
+            Target::Box(_) => speeds,
+            Target::Border => T::zero(),
         }
     }
 
@@ -418,27 +459,45 @@ where
         Kinematics::new_unchecked(self.balls.chord[i], Vector::zeros())
     }
 
-    /// Whether a ball moving at `u` does not approach `target`, moving at
-    /// `other_velocity`, along `normal` (into it) by more than [`Allowance::of`]: no
-    /// contact worth acting on.
-    fn not_approaching(
+    /// Whether a ball moving at `u` against `target`, moving at `other_velocity`, along
+    /// `normal` (into it) at in-step time `s` is no contact worth acting on: approaching
+    /// no faster than its [`Allowance::of`], unless it is [`Self::sunk`] (touching,
+    /// with `status`) and approaching faster than the rounding alone
+    /// ([`Allowance::sunk_rounding`]).
+    #[allow(clippy::too_many_arguments)]
+    fn no_contact(
         &self,
+        status: Status,
         ball: usize,
         target: Target,
-        u: &Vector<T, D>,
-        other_velocity: &Vector<T, D>,
+        (u, other_velocity): (&Vector<T, D>, &Vector<T, D>),
         normal: &Vector<T, D>,
+        s: T,
+        shift: &Vector<T, D>,
     ) -> bool {
         let approach = (u - other_velocity).dot(normal);
-        approach <= (self.allowance).of(self.balls, ball, target, u, other_velocity, normal)
+        let allowance = &self.allowance;
+        // Within the floor: no contact, but for a pair sunk deeper than it lets a contact
+        // sink, which is allowed only rounding (checked last: rarely needed).
+        approach <= allowance.of(self.balls, ball, target, u, other_velocity, normal)
+            && !(status == Status::AlreadyTouching
+                && approach > Allowance::sunk_rounding(self.balls, ball, target, u, other_velocity)
+                && self.sunk(ball, target, s, shift, normal))
     }
 
     /// Whether ball `i` is sunk into `target` (its image shifted by `shift`) at `s`:
     /// deeper than the floor lets a contact sink in a step, plus the rounding of both
     /// bodies' coordinates ([`sunk`] for a ball; for a box, the box taken as a point at
-    /// its centre in [`Allowance::sunk_depth`]). Never into a wall, whose allowance
-    /// counts no speeds.
-    fn sunk(&self, i: usize, target: Target, s: T, shift: &Vector<T, D>) -> bool {
+    /// its centre in [`Allowance::sunk_depth`]; for the wall `normal` points into, the
+    /// wall's rounding taken where the ball is, as a hold takes it).
+    fn sunk(
+        &self,
+        i: usize,
+        target: Target,
+        s: T,
+        shift: &Vector<T, D>,
+        normal: &Vector<T, D>,
+    ) -> bool {
         let b = self.balls;
         let (x, r) = (b.position_at(i, s), b.radius[i]);
         match target {
@@ -451,7 +510,19 @@ where
                 let depth = -signed_distance(&Ball::new_unchecked(x, r), &obb);
                 depth > (self.allowance).sunk_depth(&x, r, &obb.center(), T::zero())
             }
-            Target::Border => false,
+            Target::Border => self.border.is_some_and(|border| {
+                // The wall the normal points into (an axis, outwards).
+                let gaps = border.wall_gaps(&Ball::new_unchecked(x, r));
+                let depth = (0..D).fold(T::zero(), |depth, k| {
+                    let (below, above) = gaps[k];
+                    match normal[k].partial_cmp(&T::zero()) {
+                        Some(Ordering::Greater) => depth.max(-above),
+                        Some(Ordering::Less) => depth.max(-below),
+                        _ => depth,
+                    }
+                });
+                depth > (self.allowance).sunk_depth(&x, r, &x, T::zero())
+            }),
         }
     }
 
@@ -483,19 +554,9 @@ where
             Status::NotConverged => return Err(Overflow { ball: ball as u32 }),
         }
         let u = &self.balls.chord[ball];
-        let approach = (u - other_velocity).dot(&toi.normal);
-        let allowance = &self.allowance;
-        if approach <= allowance.of(self.balls, ball, target, u, other_velocity, &toi.normal) {
-            // Within the floor: no contact, but for a pair sunk deeper than it lets a
-            // contact sink, which is allowed only rounding (checked last: rarely needed).
-            let units = SUNK_APPROACH_ROUNDING;
-            let sunk = toi.status == Status::AlreadyTouching
-                && approach
-                    > allowance.rounding(self.balls, ball, target, u, other_velocity, units)
-                && self.sunk(ball, target, s, &shift);
-            if !sunk {
-                return Ok(None);
-            }
+        let motion = (u, other_velocity);
+        if self.no_contact(toi.status, ball, target, motion, &toi.normal, s, &shift) {
+            return Ok(None);
         }
         let time = (s + toi.time).min(self.end);
         let x = self.balls.position_at(ball, time);
@@ -636,7 +697,15 @@ where
             );
             asked += 1;
             let sliding = matches!(toi.status, Status::AlreadyTouching | Status::Hit)
-                && self.not_approaching(i, Target::Border, &u, &Vector::zeros(), &toi.normal);
+                && self.no_contact(
+                    toi.status,
+                    i,
+                    Target::Border,
+                    (&u, &Vector::zeros()),
+                    &toi.normal,
+                    s,
+                    &Vector::zeros(),
+                );
             if !sliding || asked == D {
                 break toi;
             }
