@@ -57,7 +57,7 @@ use carom_math::{Real, Space, Vector};
 use carom_response::RigidCluster;
 use nalgebra::Const;
 
-use super::balls::BallArrays;
+use super::balls::{BallArrays, SegmentEnd};
 use crate::engine::Angular;
 
 /// A member ball's cluster id when it is in no cluster.
@@ -411,7 +411,13 @@ where
     pub(crate) fn set_member_ends(&self, balls: &mut BallArrays<T, D>, h: T) {
         for (&m, o) in self.members.iter().zip(&self.offsets) {
             let (arm, v, w) = member_motion(&self.end, o);
-            balls.set_end(m as usize, h, self.end.center() + arm, v, w);
+            balls.set_end(
+                m as usize,
+                h,
+                SegmentEnd::Place(self.end.center() + arm),
+                v,
+                w,
+            );
         }
     }
 }

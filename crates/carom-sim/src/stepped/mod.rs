@@ -196,7 +196,8 @@ where
     event_budget: u64,
     /// The current window's simultaneity window (see [`SteppedEngine::instant_width`]).
     instant: T,
-    /// The current step's length (the end of every segment in it).
+    /// The current step's length (the end of every segment in it; the last step's
+    /// while the next one is integrated).
     step_length: T,
     /// The largest distance a ball may move in one window of a periodic domain.
     periodic_reach: T,
@@ -207,8 +208,9 @@ where
     origin: Vector<T, D>,
 }
 
-/// A chunk's segment starts: positions, velocities, spins, times.
+/// A chunk's segment starts: positions, their remainders, velocities, spins, times.
 type Segment<'a, T, const D: usize> = (
+    &'a mut [Vector<T, D>],
     &'a mut [Vector<T, D>],
     &'a mut [Vector<T, D>],
     &'a mut [crate::Angular<T, D>],
@@ -481,31 +483,49 @@ where
         self.groups.clear();
         self.repeats.clear();
         let stepper = &self.stepper;
-        // Per chunk: the segments start where the balls are, then the balls are stepped
-        // and the chords follow from where they end.
+        let previous = self.step_length;
+        // Per chunk: the segments start where the balls are, with what the last step's
+        // end could not hold (see `balls`: remainders); the balls are stepped from the
+        // origin, so that `pos` holds each one's displacement, and the chords and ends
+        // follow from it.
         let run = |(start, (pos, vel, spin)): (Segment<'_, T, D>, State<'_, T, D>),
                    inverse_mass: &[T],
                    chord: &mut [Vector<T, D>],
                    supported: &mut [bool]| {
-            let (seg_x, seg_v, seg_w, seg_t) = start;
-            seg_x.copy_from_slice(pos);
+            let (seg_x, seg_r, seg_v, seg_w, seg_t) = start;
+            for ((((x, r), t), c), p) in (seg_x.iter_mut().zip(seg_r.iter_mut()))
+                .zip(seg_t.iter_mut())
+                .zip(chord.iter())
+                .zip(pos.iter_mut())
+            {
+                *r = (*r + c * (previous - *t)) - (*p - *x);
+                *x = *p;
+                *t = T::zero();
+                *p = Vector::zeros();
+            }
             seg_v.copy_from_slice(vel);
             seg_w.copy_from_slice(spin);
-            seg_t.fill(T::zero());
             supported.fill(false);
             if let Ok(mut bodies) =
                 Bodies::new(pos, vel, inverse_mass).and_then(|bodies| bodies.with_spins(spin))
             {
                 stepper.step(&mut bodies, t0, dt);
             }
-            for ((c, p), x) in chord.iter_mut().zip(pos.iter()).zip(seg_x.iter()) {
-                *c = (p - x) / h;
+            for (((c, p), x), r) in chord
+                .iter_mut()
+                .zip(pos.iter_mut())
+                .zip(seg_x.iter())
+                .zip(seg_r.iter())
+            {
+                *c = *p / h;
+                *p = x + (r + *p);
             }
         };
         let b = &mut self.balls;
         if parallel {
             b.seg_x
                 .par_chunks_mut(CHUNK)
+                .zip(b.seg_r.par_chunks_mut(CHUNK))
                 .zip(b.seg_v.par_chunks_mut(CHUNK))
                 .zip(b.seg_w.par_chunks_mut(CHUNK))
                 .zip(b.seg_t.par_chunks_mut(CHUNK))
@@ -515,13 +535,19 @@ where
                 .zip(b.inverse_mass.par_chunks(CHUNK))
                 .zip(b.chord.par_chunks_mut(CHUNK))
                 .zip(b.supported.par_chunks_mut(CHUNK))
-                .for_each(|(((((((((x, v), w), t), p), u), s), m), c), f)| {
-                    run(((x, v, w, t), (p, u, s)), m, c, f);
+                .for_each(|((((((((((x, r), v), w), t), p), u), s), m), c), f)| {
+                    run(((x, r, v, w, t), (p, u, s)), m, c, f);
                 });
         } else {
             run(
                 (
-                    (&mut b.seg_x, &mut b.seg_v, &mut b.seg_w, &mut b.seg_t),
+                    (
+                        &mut b.seg_x,
+                        &mut b.seg_r,
+                        &mut b.seg_v,
+                        &mut b.seg_w,
+                        &mut b.seg_t,
+                    ),
                     (&mut b.pos, &mut b.vel, &mut b.spin),
                 ),
                 &b.inverse_mass,
@@ -1297,8 +1323,8 @@ where
     fn step(&mut self, h: T, observer: &mut dyn Observer<T>) -> Result<T, SimError> {
         let t0 = self.clock.s;
         let parallel = self.parallel();
-        self.step_length = h;
         self.integrate(h, t0, parallel);
+        self.step_length = h;
         let mut a = T::zero();
         let mut step_contacts = 0;
         let mut first = self.periodic.is_none();

@@ -43,7 +43,7 @@ use carom_response::guard::{Bounce, CollapseGuard, RestingGuard};
 use carom_response::{Body, Coefficients, Contact, Response, normal_velocity, resolve};
 use nalgebra::Const;
 
-use super::balls::BallArrays;
+use super::balls::{BallArrays, SegmentEnd};
 use super::clusters::{Clusters, Flight};
 use super::lcp::Lcp;
 use super::narrow::{Allowance, Target, apart_speed, touch_tolerance};
@@ -329,16 +329,24 @@ where
         self.body(i, v, w)
     }
 
-    /// Re-integrates ball `i` from its segment start to the end of the step.
+    /// Re-integrates ball `i` from its segment start to the end of the step, as a
+    /// displacement from the origin (the forces do not depend on the position; see
+    /// `balls`: remainders).
     pub(super) fn reintegrate(&mut self, i: usize) {
         let b = &mut *self.balls;
-        let (mut x, mut v, mut w) = (b.seg_x[i], b.seg_v[i], b.seg_w[i]);
+        let (mut moved, mut v, mut w) = (Vector::zeros(), b.seg_v[i], b.seg_w[i]);
         let s = b.seg_t[i];
         if let Ok(dt) = TimeStep::new(self.h - s) {
-            self.stepper
-                .step_ball(&mut x, &mut v, &mut w, b.inverse_mass[i], self.t0 + s, dt);
+            (self.stepper).step_ball(
+                &mut moved,
+                &mut v,
+                &mut w,
+                b.inverse_mass[i],
+                self.t0 + s,
+                dt,
+            );
         }
-        b.set_end(i, self.h, x, v, w);
+        b.set_end(i, self.h, SegmentEnd::Moved(moved), v, w);
     }
 
     /// Applies a collision's new physical velocities to ball `i` and re-integrates it:
