@@ -266,7 +266,7 @@ pub(crate) struct Overflow {
 /// of its coordinates' last place over the rest of the step, and found again 16,384
 /// times: a false crush error. That is an allowance for one step, not for good: a
 /// member sunk into a wall, a box or a ball deeper than the floor lets a contact sink is
-/// allowed only the rounding of the velocities ([`Allowance::sunk_rounding`]), not its
+/// allowed only the rounding of the velocities ([`Allowance::rounding`]), not its
 /// chord's. A stuck pair sliding along a wall in `f32`, turning one member into it at
 /// 6.9e-4 m/s, under the 7.6e-4 m/s of `2ρ/τ` there, sank 7.4e-4 m into it in 2 s (a
 /// fuzzed scene's pair did the same in a corner); now the wall takes it at the sunk depth
@@ -339,49 +339,17 @@ where
             Target::Border => self.resting_floor * normal.dot(&self.down).abs(),
             Target::Ball(_) | Target::Box(_) => self.resting_floor,
         };
-        self.rounding(balls, ball, target, u, other_velocity, APPROACH_ROUNDING)
-            .max(floor)
+        let rounding = Self::rounding(balls, ball, target, u, other_velocity, APPROACH_ROUNDING);
+        (rounding + self.member_chords(balls, ball, target)).max(floor)
     }
 
-    /// The rounding of the approach of ball `ball` moving at `u` against `target` moving
-    /// at `other_velocity`, counting `units` units of `ε` of the two speeds (see the
-    /// type's documentation).
+    /// The rounding of the velocities the approach of ball `ball` moving at `u` against
+    /// `target` moving at `other_velocity` is computed from: `units` units of `ε` of the
+    /// two speeds (none for a wall) and, for two balls, the turn of the normal between
+    /// their centres (see the type's documentation). A [`Narrow::sunk`] contact is
+    /// allowed this alone, at [`SUNK_APPROACH_ROUNDING`]; [`Self::of`] adds the
+    /// rounding of cluster members' chords ([`Self::member_chords`]).
     pub(crate) fn rounding(
-        &self,
-        balls: &BallArrays<T, D>,
-        ball: usize,
-        target: Target,
-        u: &Vector<T, D>,
-        other_velocity: &Vector<T, D>,
-        units: f64,
-    ) -> T {
-        let chords = match target {
-            Target::Ball(j) => {
-                self.member_chord(balls, ball) + self.member_chord(balls, j as usize)
-            }
-            Target::Box(_) | Target::Border => self.member_chord(balls, ball),
-        };
-        Self::velocity_rounding(balls, ball, target, u, other_velocity, units) + chords
-    }
-
-    /// The rounding a [`Narrow::sunk`] contact's approach is allowed: `4 ε` of the two
-    /// speeds and the turn of a pair's normal, not a cluster member's chord (see the
-    /// type's documentation).
-    pub(crate) fn sunk_rounding(
-        balls: &BallArrays<T, D>,
-        ball: usize,
-        target: Target,
-        u: &Vector<T, D>,
-        other_velocity: &Vector<T, D>,
-    ) -> T {
-        let units = SUNK_APPROACH_ROUNDING;
-        Self::velocity_rounding(balls, ball, target, u, other_velocity, units)
-    }
-
-    /// The rounding of the velocities an approach is computed from: `units` units of `ε`
-    /// of the two speeds (none for a wall) and, for two balls, the turn of the normal
-    /// between their centres.
-    fn velocity_rounding(
         balls: &BallArrays<T, D>,
         ball: usize,
         target: Target,
@@ -400,6 +368,17 @@ where
             }
             Target::Box(_) => speeds,
             Target::Border => T::zero(),
+        }
+    }
+
+    /// How well the chords of the contact's cluster members are known ([`Self::member_chord`]
+    /// of ball `ball` and, for two balls, of the other).
+    fn member_chords(&self, balls: &BallArrays<T, D>, ball: usize, target: Target) -> T {
+        match target {
+            Target::Ball(j) => {
+                self.member_chord(balls, ball) + self.member_chord(balls, j as usize)
+            }
+            Target::Box(_) | Target::Border => self.member_chord(balls, ball),
         }
     }
 
@@ -463,7 +442,7 @@ where
     /// `normal` (into it) at in-step time `s` is no contact worth acting on: approaching
     /// no faster than its [`Allowance::of`], unless it is [`Self::sunk`] (touching,
     /// with `status`) and approaching faster than the rounding alone
-    /// ([`Allowance::sunk_rounding`]).
+    /// ([`Allowance::rounding`]).
     #[allow(clippy::too_many_arguments)]
     fn no_contact(
         &self,
@@ -477,11 +456,13 @@ where
     ) -> bool {
         let approach = (u - other_velocity).dot(normal);
         let allowance = &self.allowance;
+        let units = SUNK_APPROACH_ROUNDING;
         // Within the floor: no contact, but for a pair sunk deeper than it lets a contact
         // sink, which is allowed only rounding (checked last: rarely needed).
         approach <= allowance.of(self.balls, ball, target, u, other_velocity, normal)
             && !(status == Status::AlreadyTouching
-                && approach > Allowance::sunk_rounding(self.balls, ball, target, u, other_velocity)
+                && approach
+                    > Allowance::rounding(self.balls, ball, target, u, other_velocity, units)
                 && self.sunk(ball, target, s, shift, normal))
     }
 
