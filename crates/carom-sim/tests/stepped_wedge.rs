@@ -655,6 +655,51 @@ fn a_squeeze_beyond_f32s_mass_ratio_throws_no_ball_faster_than_the_scene_starts(
     assert_no_ball_thrown(&s, fastest, "f64");
 }
 
+/// A 3.8 mg ball among balls of up to 451 t, one of them at 6.9e5 m/s, in a 2 m box
+/// (`stepped_fuzz --seed 42`'s s01, `--dt 0.01`): elastic bounces between the heavy
+/// balls and the walls pump it, as they would exactly, to 1.7e7 m/s within 1.8e-5 s
+/// and to 1e9 m/s within 0.03 s. In `f32` a last place of the step's time near its end is 1.2e-9
+/// s, in which it then travels 2e-2 m, more than its diameter (1.6e-2 m): its contacts'
+/// places are rounded by more than the balls they are with. Before the guard the run
+/// went on, the ball 0.37 m outside the border by 0.009 s, and ended with an overflow
+/// of a time of impact at 0.02 s. Now the run ends where the ball first travels more
+/// than its diameter, with an error naming it, while in `f64` (a last place 2.2e-18 s)
+/// the same pumping runs on inside the border.
+const F32_LIGHT_BALL_PUMPED_PAST_THE_STEPS_TIME: &str =
+    include_str!("scenes/f32_light_ball_pumped_past_the_steps_time.toml");
+
+#[test]
+fn a_ball_pumped_past_what_f32_resolves_in_a_step_ends_the_run_with_an_error_naming_it() {
+    let s = scene_2d(F32_LIGHT_BALL_PUMPED_PAST_THE_STEPS_TIME);
+    let light = 6;
+    for integrator in [Integrator::SemiImplicitEuler, Integrator::Exact] {
+        let mut sim = stepped(&s.cast::<f32>().unwrap(), integrator, DT);
+        let e = sim
+            .advance_to(DT as f32, &mut ())
+            .expect_err(&format!("{integrator}: f32 cannot resolve the pumped ball"));
+        assert!(
+            e.message.starts_with(&format!("balls[{light}] moves at "))
+                && e.message.contains("--precision f64"),
+            "{integrator}: {e}"
+        );
+        assert!(e.time > 0.0 && e.time < 2e-5, "{integrator}: {e}");
+    }
+    let mut sim = stepped(&s, Integrator::Exact, DT);
+    let mut fastest = 0.0_f64;
+    for k in 1..=3 {
+        sim.advance_to(f64::from(k) * DT, &mut ())
+            .unwrap_or_else(|e| panic!("f64, step {k}: {e}"));
+        let now = states(&sim);
+        let out = outside_border(&s, &now);
+        assert!(out <= 1e-12, "f64, step {k}: {out:e} m outside the border");
+        fastest = fastest.max(now.vel[light].norm());
+    }
+    assert!(
+        fastest > 2e7,
+        "f64 pumps the light ball past f32's limit too, to {fastest:e} m/s"
+    );
+}
+
 /// A 0.16 kg ball, spun by its bounces off the walls (friction 0.076) to 922,802 rad/s,
 /// 19,312 m/s at its surface, meets a 211,605 kg ball moving at 0.12 m/s with restitution
 /// 0 at 0.849 s (the third campaign's s24, reduced to three of its balls; no gravity, no
