@@ -102,9 +102,10 @@ const SIMULTANEITY: f64 = 1e-6;
 /// scene start with).
 const SIMULTANEOUS_TRAVEL: f64 = 1e-9;
 
-/// The farthest a ball that meets balls or boxes may travel in one last place of the
-/// step's time, in its radii (a diameter): beyond it the run ends with an error naming
-/// the ball (see [`SteppedEngine::resolved_in_time`]).
+/// The farthest a ball may travel in one last place of the step's time, in its radii
+/// (a diameter), when a contact other than a free ball's with a wall changes it: beyond
+/// it the run ends with an error naming the ball (see
+/// [`SteppedEngine::resolved_in_time`]).
 const RESOLVED_TRAVEL: f64 = 2.0;
 
 /// The most sub-steps one step is cut into for turning clusters: a cluster turning
@@ -1082,6 +1083,7 @@ where
             }
             let changed = core::mem::take(&mut self.changed);
             let mut cut = false;
+            let only_a_wall = matches!(e.target, Target::Border) && changed.len() == 1;
             for &c in &changed {
                 let c = c as usize;
                 self.balls.version[c] = self.balls.version[c].wrapping_add(1);
@@ -1093,7 +1095,7 @@ where
                 cut |= self.sweep.moved(c, path) > self.escape_bound;
                 let speed = self.balls.chord[c].norm();
                 cut |= speed * (b - e.time) > self.periodic_reach;
-                if !matches!(e.target, Target::Border) {
+                if !only_a_wall {
                     self.resolved_in_time(c, speed, h, t0 + e.time)?;
                 }
             }
@@ -1151,9 +1153,10 @@ where
         )
     }
 
-    /// Whether ball `i`, just changed by a contact with a ball or a box at internal time
-    /// `t` and now moving at `speed` in a step of length `h`, moves slowly enough for the
-    /// step's time to place its contacts: an error naming it if not.
+    /// Whether ball `i`, just changed at internal time `t` by a contact (other than a
+    /// free ball's with a wall) and now moving at `speed` in a step of length `h`, moves
+    /// slowly enough for the step's time to place its contacts: an error naming it if
+    /// not.
     ///
     /// Contacts are found and answered at in-step times, whose last place near the step's
     /// end is `ε h` (1.2e-9 s for `f32` and `h = 0.01` s; 2.2e-18 s in `f64`). Rounding a
@@ -1164,10 +1167,12 @@ where
     /// and a wall meets them ever faster) is left to rounding. The campaigns' seed 42,
     /// s01 (`f32`, a 3.8 mg ball pumped by balls of up to 451 t) went on from there to
     /// 0.37 m outside the border and a time of impact overflowing; every other run of the
-    /// six campaigns stays below the limit (a periodic one reached 1.5 radii). A wall is
-    /// exempt: it is a half-space, which its reflection keeps the ball inside of wherever
-    /// along its path the rounded time puts the contact (a 1 mm ball at 1.04e7 m/s, twelve
-    /// diameters per last place, bounces in a box with its speed kept; `docs/stepped.md`).
+    /// six campaigns stays below the limit (a periodic one reached 1.5 radii). A free
+    /// ball's contact with a wall is exempt: a wall is a half-space, which its reflection
+    /// keeps the ball inside of wherever along its path the rounded time puts the contact
+    /// (a 1 mm ball at 1.04e7 m/s, twelve diameters per last place, bounces in a box with
+    /// its speed kept; `docs/stepped.md`). A wall contact that changes more balls (a
+    /// cluster's, a hold's) is not: those balls touch each other.
     fn resolved_in_time(&self, i: usize, speed: T, h: T, t: T) -> Result<(), SimError> {
         let spacing = T::EPSILON * h;
         let radius = self.balls.radius[i];
