@@ -255,8 +255,8 @@ fn a_ball_at_a_million_metres_per_second_stays_in_the_border_and_out_of_thin_box
     assert!(sim.counters().ball_box > 100 && sim.counters().ball_border > 100);
 }
 
-/// In `f32`, a 1 mm ball at 1.04e7 m/s bouncing in a 2 m box, `--dt 0.01`: in a last
-/// place of the step's time near its end (1.2e-9 s) it travels 1.2e-2 m, twelve
+/// In `f32`, a ball of radius 1 mm at 1.04e7 m/s bouncing in a 2 m box, `--dt 0.01`: in
+/// a last place of the step's time near its end (1.2e-9 s) it travels 1.2e-2 m, six
 /// diameters, which ends a run whose ball meets another ball or a box so (the engine
 /// cannot place such contacts; `a_ball_pumped_past_what_f32_resolves_in_a_step_...` in
 /// stepped_wedge.rs). A wall is a half-space that its reflection keeps the ball inside

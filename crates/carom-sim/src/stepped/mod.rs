@@ -1170,8 +1170,8 @@ where
     /// six campaigns stays below the limit (a periodic one reached 1.5 radii). A free
     /// ball's contact with a wall is exempt: a wall is a half-space, which its reflection
     /// keeps the ball inside of wherever along its path the rounded time puts the contact
-    /// (a 1 mm ball at 1.04e7 m/s, twelve diameters per last place, bounces in a box with
-    /// its speed kept; `docs/stepped.md`). A wall contact that changes more balls (a
+    /// (a ball of radius 1 mm at 1.04e7 m/s, six diameters per last place, bounces in a
+    /// box with its speed kept; `docs/stepped.md`). A wall contact that changes more balls (a
     /// cluster's, a hold's) is not: those balls touch each other.
     fn resolved_in_time(&self, i: usize, speed: T, h: T, t: T) -> Result<(), SimError> {
         let spacing = T::EPSILON * h;
