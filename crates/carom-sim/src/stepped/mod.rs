@@ -73,7 +73,7 @@ use self::response::{Contacts, Effect, RestSets, Rules, Surface};
 use self::rest::{Support, Touch};
 use self::stack::{Groups, SeedOther};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
-use self::wedge::{CRUSH_CONTACTS, Repeat, Repeats};
+use self::wedge::{Repeat, Repeats, WEDGE_CONTACTS, wedge_limit};
 
 /// Escapees per parallel task of the step's first predictions (each is a broad-phase
 /// query and a few times of impact: 1.4 µs on average, timed on a 1e5-ball gas).
@@ -754,9 +754,19 @@ where
         } else {
             instant
         };
-        let mut repeat = self.repeats.note(i, e.time, instant, link);
+        // An elastic squeeze of a light ball by a heavy one takes about π √(M/m)
+        // contacts, which may crowd into one instant (see `wedge`).
+        let b = &self.balls;
+        let limit = match e.target {
+            Target::Ball(j) if b.restitution[i].min(b.restitution[j as usize]) == T::one() => {
+                let (a, c) = (b.inverse_mass[i], b.inverse_mass[j as usize]);
+                wedge_limit((a.max(c) / a.min(c)).to_f64())
+            }
+            Target::Ball(_) | Target::Border | Target::Box(_) => WEDGE_CONTACTS,
+        };
+        let mut repeat = self.repeats.note(i, e.time, instant, link, limit);
         if other != i {
-            repeat = repeat.max(self.repeats.note(other, e.time, instant, link));
+            repeat = repeat.max(self.repeats.note(other, e.time, instant, link, limit));
         }
         if repeat == Repeat::Crushed {
             let reason = self.crush_reason(i, e.time);
@@ -768,7 +778,8 @@ where
             return Err(SimError::new(
                 ((t0 + e.time) * self.clock.sign + T::zero()).to_f64(),
                 format!(
-                    "balls[{i}] is crushed: more than {CRUSH_CONTACTS} contacts at one instant (the last with {by}), even held against all of them at once: {reason}"
+                    "balls[{i}] is crushed: more than {} contacts at one instant (the last with {by}), even held against all of them at once: {reason}",
+                    self.repeats.crush_limit(i)
                 ),
             ));
         }

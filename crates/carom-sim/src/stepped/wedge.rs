@@ -32,6 +32,22 @@
 //! that does not end, instead of spending the event budget (a million contacts, tens of
 //! seconds) on every step. A box closing on a ball at a slant squeezes it out sideways
 //! (the wedge's hold finds that), which is no crush.
+//!
+//! An **elastic squeeze** is no wedge, however many contacts it takes at one instant: a
+//! light ball of mass `m` between a wall and a ball of mass `M` closing on it is pumped
+//! by every contact and sends the heavy ball back after about `π √(M/m)` of them, with
+//! the energy kept (Galperin's billiard: in the coordinates `√m x` and `√M X` each
+//! elastic contact is a mirror reflection off one side of a wedge of angle
+//! `θ = atan √(m/M)`, and a path meets the sides of such a wedge `⌈π/θ⌉ − 1` times).
+//! Near the turn the contacts crowd into one instant (1 g pumped by 1e5 kg at 1e5 m/s:
+//! 3e-14 s apart), and a hold at the wedge limit of 256 took the heavy ball's energy
+//! (5e14 J to 0.43 J). So a ball's limit is [`wedge_limit`] of the largest mass ratio
+//! among its elastic ball contacts (pair restitution 1) since its count began: an
+//! inelastic squeeze ends only in the hold (a collapse), whose answer it is, and takes
+//! [`WEDGE_CONTACTS`] as before. The limit is `4 √(M/m)`, at least
+//! [`WEDGE_CONTACTS`] and at most [`MAX_WEDGE_CONTACTS`] (a ratio of 2.7e8; beyond it a
+//! squeeze is still held with restitution 0, and loses its energy). The crush limit
+//! moves with it, [`CRUSH_CONTACTS`] − [`WEDGE_CONTACTS`] contacts beyond.
 
 use carom_math::Real;
 
@@ -44,6 +60,32 @@ pub(crate) const WEDGE_CONTACTS: u32 = 256;
 /// Contacts of one ball at one instant beyond which it is crushed: 64 times the wedge
 /// limit, so that a wedge is held many times first.
 pub(crate) const CRUSH_CONTACTS: u32 = 64 * WEDGE_CONTACTS;
+
+/// Contacts per square root of the mass ratio allowed before a ball is wedged: an
+/// elastic squeeze takes `π` (see the [module documentation](self)), and this leaves it a
+/// quarter more.
+const CONTACTS_PER_ROOT_OF_MASS_RATIO: f64 = 4.0;
+
+/// The most contacts of one ball at one instant before it is wedged, whatever the mass
+/// ratio: an elastic squeeze of a ratio up to `(MAX_WEDGE_CONTACTS / 4)²`, 2.7e8, runs
+/// to its end. A hold costs a step this many contacts at most (a millisecond each at
+/// worst, measured as the event loop's throughput).
+pub(crate) const MAX_WEDGE_CONTACTS: u32 = 65_536;
+
+/// The wedge limit for a contact between balls whose masses differ by `ratio` (the
+/// heavier's over the lighter's, at least 1): `4 √ratio` contacts, clamped to
+/// [`WEDGE_CONTACTS`] and [`MAX_WEDGE_CONTACTS`].
+pub(crate) fn wedge_limit(ratio: f64) -> u32 {
+    let pumped = CONTACTS_PER_ROOT_OF_MASS_RATIO * ratio.sqrt();
+    if pumped >= f64::from(MAX_WEDGE_CONTACTS) {
+        MAX_WEDGE_CONTACTS
+    } else if pumped > f64::from(WEDGE_CONTACTS) {
+        pumped.ceil() as u32
+    } else {
+        // Also a NaN ratio (no ball has one: masses are positive and finite).
+        WEDGE_CONTACTS
+    }
+}
 
 /// What a ball's contacts at one instant say about it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -67,6 +109,16 @@ struct Record<T> {
     last: T,
     count: u32,
     chain: u32,
+    /// The wedge limit of the contacts since the count or the chain began (the larger
+    /// of theirs).
+    limit: u32,
+}
+
+impl<T> Record<T> {
+    /// Contacts at one instant beyond which the ball is crushed.
+    fn crush_limit(&self) -> u32 {
+        self.limit.saturating_add(CRUSH_CONTACTS - WEDGE_CONTACTS)
+    }
 }
 
 /// Per ball, the instant its recent contacts cluster around and how many it had there.
@@ -101,11 +153,12 @@ impl<T: Real> Repeats<T> {
         prefetch(&self.records[i]);
     }
 
-    /// Notes a contact of ball `i` at in-step time `s` and tells what its contacts within
-    /// `tolerance` of the first of them say (a contact further away starts a new
-    /// instant), and its chain of contacts each within `link` of the one before: a chain
-    /// longer than [`WEDGE_CONTACTS`] wedges it too.
-    pub(crate) fn note(&mut self, i: usize, s: T, tolerance: T, link: T) -> Repeat {
+    /// Notes a contact of ball `i` at in-step time `s` whose wedge limit is `limit` (see
+    /// [`wedge_limit`]) and tells what its contacts within `tolerance` of the first of
+    /// them say (a contact further away starts a new instant), and its chain of contacts
+    /// each within `link` of the one before: a chain longer than the limit wedges it
+    /// too. The limit is the largest of the contacts since the count or the chain began.
+    pub(crate) fn note(&mut self, i: usize, s: T, tolerance: T, link: T, limit: u32) -> Repeat {
         let record = &mut self.records[i];
         let fresh = record.count == 0;
         if fresh {
@@ -123,11 +176,21 @@ impl<T: Real> Repeats<T> {
             record.chain = record.chain.saturating_add(1);
         }
         record.last = s;
+        record.limit = if record.count == 1 && record.chain == 1 {
+            limit
+        } else {
+            record.limit.max(limit)
+        };
         match (record.count, record.chain) {
-            (c, _) if c > CRUSH_CONTACTS => Repeat::Crushed,
-            (c, k) if c > WEDGE_CONTACTS || k > WEDGE_CONTACTS => Repeat::Wedged,
+            (c, _) if c > record.crush_limit() => Repeat::Crushed,
+            (c, k) if c > record.limit || k > record.limit => Repeat::Wedged,
             _ => Repeat::Free,
         }
+    }
+
+    /// Contacts at one instant beyond which ball `i` is crushed now.
+    pub(crate) fn crush_limit(&self, i: usize) -> u32 {
+        self.records[i].crush_limit()
     }
 }
 
@@ -140,15 +203,64 @@ mod tests {
         let mut r = Repeats::<f64>::new(2);
         for k in 0..WEDGE_CONTACTS {
             let s = 0.5 + f64::from(k) * 1e-15;
-            assert_eq!(r.note(0, s, 1e-9, 1e-9), Repeat::Free, "contact {k}");
+            assert_eq!(
+                r.note(0, s, 1e-9, 1e-9, WEDGE_CONTACTS),
+                Repeat::Free,
+                "contact {k}"
+            );
         }
         for k in WEDGE_CONTACTS..CRUSH_CONTACTS {
             let s = 0.5 + f64::from(k) * 1e-15;
-            assert_eq!(r.note(0, s, 1e-9, 1e-9), Repeat::Wedged, "contact {k}");
+            assert_eq!(
+                r.note(0, s, 1e-9, 1e-9, WEDGE_CONTACTS),
+                Repeat::Wedged,
+                "contact {k}"
+            );
         }
-        assert_eq!(r.note(0, 0.5 + 1e-12, 1e-9, 1e-9), Repeat::Crushed);
+        assert_eq!(
+            r.note(0, 0.5 + 1e-12, 1e-9, 1e-9, WEDGE_CONTACTS),
+            Repeat::Crushed
+        );
         // The other ball has its own count.
-        assert_eq!(r.note(1, 0.5, 1e-9, 1e-9), Repeat::Free);
+        assert_eq!(r.note(1, 0.5, 1e-9, 1e-9, WEDGE_CONTACTS), Repeat::Free);
+    }
+
+    #[test]
+    fn the_wedge_limit_grows_with_the_square_root_of_the_mass_ratio_within_its_bounds() {
+        assert_eq!(wedge_limit(1.0), WEDGE_CONTACTS);
+        assert_eq!(wedge_limit(4096.0), WEDGE_CONTACTS);
+        assert_eq!(wedge_limit(1e6), 4000);
+        // Galperin's 31,415 contacts at a ratio of 1e8 fit, with a quarter to spare.
+        assert_eq!(wedge_limit(1e8), 40_000);
+        assert_eq!(wedge_limit(1e12), MAX_WEDGE_CONTACTS);
+        assert_eq!(wedge_limit(f64::INFINITY), MAX_WEDGE_CONTACTS);
+        assert_eq!(wedge_limit(f64::NAN), WEDGE_CONTACTS);
+    }
+
+    #[test]
+    fn a_raised_limit_lasts_while_the_contacts_crowd_and_moves_the_crush_limit_with_it() {
+        let mut r = Repeats::<f64>::new(1);
+        let limit = 4000;
+        // Its first contact raises the limit; the wall contacts between keep it.
+        for k in 0..limit {
+            let (s, own) = (
+                0.5 + f64::from(k) * 1e-15,
+                [limit, WEDGE_CONTACTS][k as usize % 2],
+            );
+            assert_eq!(r.note(0, s, 1e-9, 1e-9, own), Repeat::Free, "contact {k}");
+        }
+        assert_eq!(r.note(0, 0.5, 1e-9, 1e-9, WEDGE_CONTACTS), Repeat::Wedged);
+        assert_eq!(r.crush_limit(0), limit + CRUSH_CONTACTS - WEDGE_CONTACTS);
+        for _ in limit + 1..r.crush_limit(0) {
+            assert_eq!(r.note(0, 0.5, 1e-9, 1e-9, WEDGE_CONTACTS), Repeat::Wedged);
+        }
+        assert_eq!(r.note(0, 0.5, 1e-9, 1e-9, WEDGE_CONTACTS), Repeat::Crushed);
+        // A contact at another instant, beyond the chain's link, starts with its own limit.
+        assert_eq!(r.note(0, 0.75, 1e-9, 1e-9, WEDGE_CONTACTS), Repeat::Free);
+        for _ in 1..WEDGE_CONTACTS {
+            r.note(0, 0.75, 1e-9, 1e-9, WEDGE_CONTACTS);
+        }
+        assert_eq!(r.note(0, 0.75, 1e-9, 1e-9, WEDGE_CONTACTS), Repeat::Wedged);
     }
 
     #[test]
@@ -156,13 +268,16 @@ mod tests {
         let mut r = Repeats::<f64>::new(1);
         // A ball rattling between walls: many contacts, each one instant apart.
         for k in 0..2 * CRUSH_CONTACTS {
-            assert_eq!(r.note(0, f64::from(k) * 1e-6, 1e-9, 1e-9), Repeat::Free);
+            assert_eq!(
+                r.note(0, f64::from(k) * 1e-6, 1e-9, 1e-9, WEDGE_CONTACTS),
+                Repeat::Free
+            );
         }
         for _ in 0..WEDGE_CONTACTS {
-            r.note(0, 0.25, 1e-9, 1e-9);
+            r.note(0, 0.25, 1e-9, 1e-9, WEDGE_CONTACTS);
         }
         r.clear();
-        assert_eq!(r.note(0, 0.25, 1e-9, 1e-9), Repeat::Free);
+        assert_eq!(r.note(0, 0.25, 1e-9, 1e-9, WEDGE_CONTACTS), Repeat::Free);
     }
 
     #[test]
@@ -174,7 +289,7 @@ mod tests {
         for k in 0..4 * WEDGE_CONTACTS {
             let s = 0.5 + f64::from(k) * 1.2e-12;
             assert_eq!(
-                separate.note(0, s, 1e-12, 1e-12),
+                separate.note(0, s, 1e-12, 1e-12, WEDGE_CONTACTS),
                 Repeat::Free,
                 "contact {k}"
             );
@@ -183,9 +298,16 @@ mod tests {
             } else {
                 Repeat::Wedged
             };
-            assert_eq!(chained.note(0, s, 1e-12, 1e-10), expected, "contact {k}");
+            assert_eq!(
+                chained.note(0, s, 1e-12, 1e-10, WEDGE_CONTACTS),
+                expected,
+                "contact {k}"
+            );
         }
         // A chain never crushes on its own: that takes contacts at one instant.
-        assert_eq!(chained.note(0, 0.5 + 1e-6, 1e-12, 1e-3), Repeat::Wedged);
+        assert_eq!(
+            chained.note(0, 0.5 + 1e-6, 1e-12, 1e-3, WEDGE_CONTACTS),
+            Repeat::Wedged
+        );
     }
 }
