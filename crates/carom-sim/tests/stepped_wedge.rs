@@ -863,7 +863,7 @@ fn squeeze_by_collision_law(ratio: f64, speed: f64) -> (u64, f64, f64) {
 /// A light ball squeezed elastically between a wall and a heavy ball is pumped by every
 /// contact and sends the heavy ball back after `⌊π √(M/m)⌋` contacts (Galperin's
 /// billiard: 314, 3,141 and 31,415 for mass ratios 1e4, 1e6 and 1e8), which crowd into
-/// one instant near the turn (3e-14 s apart at 1e8 and 1e5 m/s). Held as a wedge after
+/// one instant near the turn (about 3e-14 s apart at 1e8 and 1e5 m/s, estimated in `wedge`). Held as a wedge after
 /// 256 of them, restitution 0, the squeeze took the heavy ball's energy: 1 g struck by
 /// 1e5 kg at 1e5 m/s ended with 0.43 J of 5e14 J, at a ratio of 1e6 and 1e5 m/s with
 /// 2.6e-7 J of 5e12 J (see `wedge`). Now every integrator, at 1 m/s to 1e6 m/s, takes
