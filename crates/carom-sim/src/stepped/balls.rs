@@ -142,6 +142,12 @@ where
         self.radius.len()
     }
 
+    /// The restitution of a contact between balls `i` and `j`: the smaller of theirs (the
+    /// scene contract's pair rule, `Scene::pair_restitution`).
+    pub(crate) fn pair_restitution(&self, i: usize, j: usize) -> T {
+        self.restitution[i].min(self.restitution[j])
+    }
+
     /// Prefetches every field of ball `i` (see `prefetch`).
     pub(crate) fn prefetch_row(&self, i: usize) {
         prefetch(&self.radius[i]);

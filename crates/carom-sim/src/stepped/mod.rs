@@ -758,7 +758,7 @@ where
         // contacts, which may crowd into one instant (see `wedge`).
         let b = &self.balls;
         let limit = match e.target {
-            Target::Ball(j) if b.restitution[i].min(b.restitution[j as usize]) == T::one() => {
+            Target::Ball(j) if b.pair_restitution(i, j as usize) == T::one() => {
                 let (a, c) = (b.inverse_mass[i], b.inverse_mass[j as usize]);
                 wedge_limit((a.max(c) / a.min(c)).to_f64())
             }
@@ -829,9 +829,7 @@ where
         let (effect, collision): (Effect, Collision<T>) = match e.target {
             Target::Ball(j) => {
                 let j = j as usize;
-                let sticks = self.rules.stick
-                    && contacts.balls.restitution[i].min(contacts.balls.restitution[j])
-                        == T::zero();
+                let sticks = self.rules.stick && contacts.balls.pair_restitution(i, j) == T::zero();
                 let grouped = contacts.groups.grouped(i) || contacts.groups.grouped(j);
                 let effect = if wedged && !clustered && !sticks {
                     contacts.wedged(i, SeedOther::Ball(j), e.time)

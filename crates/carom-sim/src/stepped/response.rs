@@ -386,7 +386,7 @@ where
             self.body(i, b.seg_v[i], b.seg_w[i]),
             self.body(j, b.seg_v[j], b.seg_w[j]),
         );
-        let nominal = b.restitution[i].min(b.restitution[j]);
+        let nominal = b.pair_restitution(i, j);
         let (approach, r) = self.pair_collision(&bi, &bj, &contact, nominal);
         let slow = approach <= self.rules.support_speed;
         // A slow contact onto a support (a ball holding the other up, see `holds_up`) is

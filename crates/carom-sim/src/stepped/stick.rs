@@ -144,7 +144,7 @@ where
         } else {
             *fallback_normal
         };
-        let nominal = balls.restitution[i].min(balls.restitution[j]);
+        let nominal = balls.pair_restitution(i, j);
         if self.rules.stick && nominal == T::zero() {
             // Where the pair touches on the chords, relative to where the bodies' rigid
             // poses put the two balls: a free ball's pose moves by the difference, else
