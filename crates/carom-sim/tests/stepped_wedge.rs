@@ -528,6 +528,26 @@ fn a_light_ball_wedged_against_a_wall_by_a_heavy_ball_is_not_taken_for_crushed()
     }
 }
 
+/// A 0.17 g ball among 33 balls of up to 357 t, no gravity, squeezed by a 9.8 kg ball
+/// into the corner of the right wall and a slanted static box (`stepped_fuzz --seed
+/// 2026`'s s59, `f64`). The wedge's hold left its box contact opening at 2.5e-105 m/s
+/// and its wall contact closing at 6.5e-105 m/s, within its aim; setting the chord's
+/// component on the wall exactly (as above) moved it back into the box, closing at
+/// 2.9e-105 m/s, past the narrow phase's allowance, relative to those speeds: the same
+/// contact again, the chord shrinking hold after hold until its norm underflowed, and a
+/// false crush error at 0.388 s with semi-implicit Euler after 16,641 contacts. Settling
+/// on a wall now also turns the ball's other contacts it closed back to opening, across
+/// the wall's axis. Every integrator, 0.5 s: no error, no ball outside the border or
+/// overlapping beyond 1e-9 m.
+const LIGHT_BALL_HELD_IN_A_CORNER_OF_A_WALL_AND_A_SLANTED_BOX: &str =
+    include_str!("scenes/light_ball_held_in_a_corner_of_a_wall_and_a_slanted_box.toml");
+
+#[test]
+fn a_light_ball_held_in_a_corner_of_a_wall_and_a_slanted_box_is_not_taken_for_crushed() {
+    let s = scene_2d(LIGHT_BALL_HELD_IN_A_CORNER_OF_A_WALL_AND_A_SLANTED_BOX);
+    assert_runs_apart_and_inside(&s, &Integrator::ALL, 0.5, "f64", 1e-9);
+}
+
 /// A 4.2 g ball flying into the left wall at 750 m/s with a 72 t ball right behind it at
 /// 759 m/s, whose contact with it is slanted by 8° (the fourth campaign's s59 with
 /// semi-implicit Euler in `f32`, reduced to its two balls at 0.16819 s; friction 0.083,

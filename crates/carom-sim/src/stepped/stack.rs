@@ -301,6 +301,15 @@ impl Groups {
     }
 }
 
+/// A free ball whose chord [`Contacts::settle_on_walls`] set on walls of the border.
+struct Settled<const D: usize, T> {
+    ball: usize,
+    /// The axes of the walls it was set on.
+    axes: [bool; D],
+    /// The largest change of a component it took.
+    moved: T,
+}
+
 /// The contact a hold is for: ball `ball` touching `other`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Seed<T: Real, const D: usize> {
@@ -616,8 +625,14 @@ where
     /// the 733 m/s the hold took from it), where a quarter of the floor was 2.4e-8 m/s:
     /// the same contact again, 16,384 times, and a false crush error (the fourth
     /// campaign's s59 with semi-implicit Euler, `f32`).
+    ///
+    /// Where setting a wall's component closes another of the ball's contacts again (a
+    /// face at a slant beside the wall), [`Self::settle_beside_walls`] opens it.
     fn settle_on_walls(&mut self, stack: &Stack<T, D>, held: &[usize], targets: &[T]) {
         let flight = self.flight();
+        // The rows' excesses as the hold left them, read before the first setting.
+        let mut before: Option<Vec<T>> = None;
+        let mut settled: Vec<Settled<D, T>> = Vec::new();
         for (&c, &target) in held.iter().zip(targets) {
             let row = &stack.rows[c];
             let (Target::Border, Side::Ball(i)) = (row.target, stack.parts[row.end.part].side)
@@ -637,16 +652,130 @@ where
             if excess <= T::zero() || excess > self.done(stack, c).max(rounding) {
                 continue;
             }
-            let b = &*self.balls;
-            let (mut seg_v, mut chord, mut vel) = (b.seg_v[i], b.chord[i], b.vel[i]);
-            let change = target * sign - chord[axis];
+            let mut chord = self.balls.chord[i];
             chord[axis] = target * sign;
-            let (start_share, end_share) = shares(&flight, b.inverse_mass[i], b.seg_t[i]);
-            seg_v[axis] += change * start_share;
-            vel[axis] += change * end_share;
-            let (seg_w, spin) = (b.seg_w[i], b.spin[i]);
-            self.balls
-                .set_segment(i, self.h, [seg_v, chord, vel], [seg_w, spin]);
+            let moved = (chord[axis] - self.balls.chord[i][axis]).abs();
+            if before.is_none() {
+                before = Some(self.excess(stack, held, targets));
+            }
+            self.set_chord(&flight, i, chord);
+            let k = settled.iter().position(|e| e.ball == i).unwrap_or_else(|| {
+                settled.push(Settled {
+                    ball: i,
+                    axes: [false; D],
+                    moved: T::zero(),
+                });
+                settled.len() - 1
+            });
+            let entry = &mut settled[k];
+            entry.axes[axis] = true;
+            entry.moved = entry.moved.max(moved);
+        }
+        if let Some(before) = before {
+            self.settle_beside_walls(stack, held, targets, &before, &settled);
+        }
+    }
+
+    /// Turns the rows of `held` that [`Self::settle_on_walls`] left closing past their
+    /// targets (by more than [`Self::done`], where the hold had left them within it:
+    /// `before`, the rows' excesses then) to open by a hair, by changing the chord of
+    /// the settled ball across its settled walls' axes only.
+    ///
+    /// A hold may leave a ball closing on a wall by less than [`Self::done`] (a quarter
+    /// of the floor there), which setting the wall's component exactly removes; where
+    /// the ball also rests on a face at a slant, that moves it back into the face. A
+    /// 0.17 g ball pressed into the corner of a wall and a slanted box by a 9.8 kg ball,
+    /// without gravity, was held with its box contact opening at 2.5e-105 m/s and its
+    /// wall contact closing at 6.5e-105 m/s; setting the wall's component left the box
+    /// contact closing at 2.9e-105 m/s, which the narrow phase, whose allowance is
+    /// relative to those speeds, found again: hold after hold at the same instant, the
+    /// chord fell to 1e-168 m/s, whose norm underflows, and a false crush error after
+    /// 16,641 contacts (`stepped_fuzz --seed 2026`'s s59, `f64`, semi-implicit Euler).
+    ///
+    /// The change for a row with normal `g` on the ball's chord (the row's normal,
+    /// reversed where the ball is its other end) is `−d (excess + margin)/|d|²`, `d`
+    /// being `g` with the settled axes' components dropped: the walls' components stay
+    /// exact, and the row's approach falls to its target less the margin, up to the
+    /// rounding of the change. That rounding is a few `ε` of the two ends' velocities,
+    /// whose largest components the margin takes 8 times (their norms underflow at such
+    /// speeds). In two dimensions this slides the ball along the face, out of the
+    /// corner. A change larger than the settling's own (a face nearly along the wall,
+    /// `|d|` near 0) is not made: the row is left as the settling left it.
+    fn settle_beside_walls(
+        &mut self,
+        stack: &Stack<T, D>,
+        held: &[usize],
+        targets: &[T],
+        before: &[T],
+        settled: &[Settled<D, T>],
+    ) {
+        let flight = self.flight();
+        for (k, (&c, &target)) in held.iter().zip(targets).enumerate() {
+            let row = &stack.rows[c];
+            if row.target == Target::Border || before[k] > self.done(stack, c) {
+                continue;
+            }
+            let ends = [
+                (row.end.ball, T::one()),
+                match row.other {
+                    Other::Part(e) => (e.ball, -T::one()),
+                    Other::Held(_) | Other::Surface(_) => (usize::MAX, T::zero()),
+                },
+            ];
+            for (i, sign) in ends {
+                let Some(ball) = settled.iter().find(|e| e.ball == i) else {
+                    continue;
+                };
+                let excess = self.approach(stack, c, Phase::Chord) - target;
+                if excess <= self.done(stack, c) {
+                    break;
+                }
+                let mut d = row.normal * sign;
+                for (axis, &set) in ball.axes.iter().enumerate() {
+                    if set {
+                        d[axis] = T::zero();
+                    }
+                }
+                let across = d.norm_squared();
+                let speeds =
+                    self.balls.chord[row.end.ball].amax() + self.other_velocity(row).amax();
+                let change = d * ((excess + T::lit(8.0) * T::EPSILON * speeds) / across);
+                // A face nearly along the wall would need a fast slide: left as it was.
+                if across > T::zero() && change.amax() <= ball.moved {
+                    let chord = self.balls.chord[i] - change;
+                    self.set_chord(&flight, i, chord);
+                }
+            }
+        }
+    }
+
+    /// Sets free ball `i`'s chord to `chord` as a held force over the rest of the step
+    /// would ([`shares`]): its velocities at the segment's start and end follow.
+    /// Components the chord keeps are left as they are in the velocities too (a `-0`
+    /// stays `-0`).
+    fn set_chord(&mut self, flight: &Flight<'_, T, D, F>, i: usize, chord: Vector<T, D>) {
+        let b = &*self.balls;
+        let (start_share, end_share) = shares(flight, b.inverse_mass[i], b.seg_t[i]);
+        let (mut seg_v, mut vel) = (b.seg_v[i], b.vel[i]);
+        for a in 0..D {
+            let change = chord[a] - b.chord[i][a];
+            if change != T::zero() {
+                seg_v[a] += change * start_share;
+                vel[a] += change * end_share;
+            }
+        }
+        let (seg_w, spin) = (b.seg_w[i], b.spin[i]);
+        self.balls
+            .set_segment(i, self.h, [seg_v, chord, vel], [seg_w, spin]);
+    }
+
+    /// The velocity of row `row`'s other end as the narrow phase reads it: a surface's
+    /// own, a ball's chord.
+    fn other_velocity(&self, row: &Row<T, D>) -> Vector<T, D> {
+        match row.other {
+            Other::Surface(v) => v,
+            Other::Held(j) => self.balls.chord[j],
+            Other::Part(e) => self.balls.chord[e.ball],
         }
     }
 
@@ -675,11 +804,7 @@ where
     fn allowed(&self, stack: &Stack<T, D>, c: usize) -> T {
         let row = &stack.rows[c];
         let b = &*self.balls;
-        let other = match row.other {
-            Other::Surface(v) => v,
-            Other::Held(j) => b.chord[j],
-            Other::Part(e) => b.chord[e.ball],
-        };
+        let other = self.other_velocity(row);
         let ball = row.end.ball;
         let allowed = (self.rules.allowance(self.h)).of(
             b,
