@@ -765,21 +765,29 @@ where
             Target::Ball(_) | Target::Border | Target::Box(_) => WEDGE_CONTACTS,
         };
         let mut repeat = self.repeats.note(i, e.time, instant, link, limit);
+        // The ball named crushed is the one whose count crossed the limit: the other ball
+        // of a pair where only it did.
+        let mut crushed = (repeat == Repeat::Crushed).then_some(i);
         if other != i {
-            repeat = repeat.max(self.repeats.note(other, e.time, instant, link, limit));
+            let other_repeat = self.repeats.note(other, e.time, instant, link, limit);
+            if other_repeat == Repeat::Crushed && crushed.is_none() {
+                crushed = Some(other);
+            }
+            repeat = repeat.max(other_repeat);
         }
-        if repeat == Repeat::Crushed {
-            let reason = self.crush_reason(i, e.time);
+        if let Some(k) = crushed {
+            let reason = self.crush_reason(k, e.time);
             let by = match e.target {
+                Target::Ball(_) if k != i => format!("balls[{i}]"),
                 Target::Ball(j) => format!("balls[{j}]"),
                 Target::Border => "the border".to_string(),
-                Target::Box(k) => format!("boxes[{k}]"),
+                Target::Box(b) => format!("boxes[{b}]"),
             };
             return Err(SimError::new(
                 ((t0 + e.time) * self.clock.sign + T::zero()).to_f64(),
                 format!(
-                    "balls[{i}] is crushed: more than {} contacts at one instant (the last with {by}), even held against all of them at once: {reason}",
-                    self.repeats.crush_limit(i)
+                    "balls[{k}] is crushed: more than {} contacts at one instant (the last with {by}), even held against all of them at once: {reason}",
+                    self.repeats.crush_limit(k)
                 ),
             ));
         }
