@@ -235,3 +235,16 @@ fn in_f32_a_light_ball_between_balls_converging_on_it_fast_is_held_not_crushed()
     // Before: a crush error at 0.0090 s with the exact and Verlet integrators.
     within_reported_rounding_with_every_integrator(&scene, 0.01, 0.1);
 }
+
+#[test]
+fn in_f32_a_ball_resting_on_another_in_a_corner_at_speeds_whose_norms_underflow_is_not_crushed() {
+    // Ball 27 rests on ball 31 in the bottom-left corner, both drifting up at 3.2e-24
+    // m/s, the lower faster by 1.2e-30 m/s (a hold's rounding). The squares of such
+    // speeds underflow in f32, so their norms were 0 and the narrow phase allowed the
+    // pair no approach: the same contact 16,385 times at one instant, a crush error at
+    // 0.012 s with both f32 integrators of the campaign.
+    let scene = f32_scene(include_str!(
+        "scenes/f32_ball_on_a_ball_in_a_corner_drifting_below_the_norms_underflow.toml"
+    ));
+    within_reported_rounding_with_every_integrator(&scene, 0.01, 0.1);
+}
