@@ -62,8 +62,8 @@ const SUNK_APPROACH_ROUNDING: f64 = 4.0;
 /// Two balls in `f32`, one resting on the other in a corner and both drifting up at
 /// 3.2e-24 m/s, the lower faster by the rounding of a hold's sums (1.2e-30 m/s), were
 /// allowed no approach at all: the same contact again, 16,385 times at one instant,
-/// and a false crush error (`stepped_fuzz --seed 42`'s s48, `f32`, at 0.012 s). Their
-/// speeds' rounding allows 4.9e-29 m/s.
+/// and a false crush error (`stepped_fuzz --seed 42`'s s48, `f32`, at 0.012 s). Read
+/// so, their speeds' rounding allows them `64 ε · 2 · 3.2e-24`, 4.9e-29 m/s.
 fn speed<T: Real, const D: usize>(v: &Vector<T, D>) -> T
 where
     Const<D>: Space<T, D>,

@@ -302,7 +302,7 @@ impl Groups {
 }
 
 /// A free ball whose chord [`Contacts::settle_on_walls`] set on walls of the border.
-struct Settled<const D: usize, T> {
+struct Settled<T, const D: usize> {
     ball: usize,
     /// The axes of the walls it was set on.
     axes: [bool; D],
@@ -632,7 +632,7 @@ where
         let flight = self.flight();
         // The rows' excesses as the hold left them, read before the first setting.
         let mut before: Option<Vec<T>> = None;
-        let mut settled: Vec<Settled<D, T>> = Vec::new();
+        let mut settled: Vec<Settled<T, D>> = Vec::new();
         for (&c, &target) in held.iter().zip(targets) {
             let row = &stack.rows[c];
             let (Target::Border, Side::Ball(i)) = (row.target, stack.parts[row.end.part].side)
@@ -707,7 +707,7 @@ where
         held: &[usize],
         targets: &[T],
         before: &[T],
-        settled: &[Settled<D, T>],
+        settled: &[Settled<T, D>],
     ) {
         let flight = self.flight();
         for (k, (&c, &target)) in held.iter().zip(targets).enumerate() {
@@ -715,14 +715,12 @@ where
             if row.target == Target::Border || before[k] > self.done(stack, c) {
                 continue;
             }
-            let ends = [
-                (row.end.ball, T::one()),
-                match row.other {
-                    Other::Part(e) => (e.ball, -T::one()),
-                    Other::Held(_) | Other::Surface(_) => (usize::MAX, T::zero()),
-                },
-            ];
-            for (i, sign) in ends {
+            // The row's ball ends, each with the sign of its chord in the approach.
+            let other_end = match row.other {
+                Other::Part(e) => Some((e.ball, -T::one())),
+                Other::Held(_) | Other::Surface(_) => None,
+            };
+            for (i, sign) in core::iter::once((row.end.ball, T::one())).chain(other_end) {
                 let Some(ball) = settled.iter().find(|e| e.ball == i) else {
                     continue;
                 };
