@@ -786,7 +786,7 @@ where
             return Err(SimError::new(
                 ((t0 + e.time) * self.clock.sign + T::zero()).to_f64(),
                 format!(
-                    "balls[{k}] is crushed: more than {} contacts at one instant (the last with {by}), even held against all of them at once: {reason}",
+                    "balls[{k}] is crushed: more than {} contacts at one instant (the last with {by}); {reason}",
                     self.repeats.crush_limit(k)
                 ),
             ));
@@ -1000,10 +1000,18 @@ where
 
     /// Why ball `i` could not be held at in-step time `s`, for a crush error: where no box
     /// it touches moves and a ball it touches is heavier or lighter by more than the
-    /// contacts' solve resolves (`lcp::RESOLVABLE_MASS_RATIO`), the mass ratio; otherwise that
-    /// the ball cannot give way.
+    /// contacts' solve resolves (`lcp::RESOLVABLE_MASS_RATIO`), the mass ratio; otherwise
+    /// that the ball cannot give way, with whether a hold took it in in this step and the
+    /// speed that hold left a contact closing at, if it did ([`Groups::last_hold`]).
     fn crush_reason(&mut self, i: usize, s: T) -> String {
-        let cannot_give_way = "it cannot give way (as when a kinematic box presses it into the border or another box from every side it could leave by)".to_string();
+        let why = "it cannot give way (as when a kinematic box presses it into the border or another box from every side it could leave by)";
+        let cannot_give_way = match self.groups.last_hold(i) {
+            Some(speed) if speed > 0.0 => format!(
+                "even held against all of them at once they still close at {speed:.3e} m/s: {why}"
+            ),
+            Some(_) => format!("even held against all of them at once: {why}"),
+            None => why.to_string(),
+        };
         let b = &self.balls;
         let (x, r) = (b.position_at(i, s), b.radius[i]);
         let tolerance = touch_tolerance(&x, r);

@@ -266,6 +266,10 @@ pub(crate) struct Groups {
     of: Vec<u32>,
     /// Per group: its balls (a cluster's members all).
     balls: Vec<Vec<u32>>,
+    /// The balls held in this step, in the order of their holds, each with how fast its
+    /// hold left a row closing beyond its target where that exceeded the resting floor
+    /// (the fastest of its rows), or 0: for a crush error (see [`Groups::last_hold`]).
+    held: Vec<(u32, f64)>,
 }
 
 /// A ball in no group.
@@ -277,6 +281,7 @@ impl Groups {
         Self {
             of: vec![NONE; n],
             balls: Vec::new(),
+            held: Vec::new(),
         }
     }
 
@@ -288,6 +293,23 @@ impl Groups {
             }
         }
         self.balls.clear();
+        self.held.clear();
+    }
+
+    /// What the last hold of ball `i` in this step left: `None` if no hold took it in;
+    /// `Some(speed)` if one did, `speed` how fast it left one of its rows closing beyond
+    /// its target where that exceeded the resting floor, 0 if it stopped them all. The
+    /// hold's impulses are exact (`lcp`), so a speed shows that no impulses could stop
+    /// the contacts it held, as when a kinematic box closes on a ball against the
+    /// border. A 0 says nothing of contacts the hold did not take in: one that approaches
+    /// fast and does not touch yet is left to its own collision. A stuck cluster's
+    /// contacts are answered one at a time unless its chords still close after an
+    /// impulse (fuzzed: a cluster's member between the left wall and a box's face closing
+    /// on it at 35 m/s, crushed without a hold in that step).
+    pub(crate) fn last_hold(&self, i: usize) -> Option<f64> {
+        (self.held.iter().rev())
+            .find(|&&(b, _)| b as usize == i)
+            .map(|&(_, speed)| speed)
     }
 
     /// Prefetches ball `i`'s group (see `prefetch`): every contact reads it.
@@ -575,6 +597,7 @@ where
         let closing: Vec<usize> = self.closing(stack, held, &targets).collect();
         if closing.is_empty() {
             self.settle_on_walls(stack, held, &targets);
+            self.note_hold(stack, held, &targets);
             return;
         }
         // Jammed: the rotation over the rest of the step brings members into surfaces on
@@ -604,6 +627,26 @@ where
         self.save_free(stack);
         self.hold_rounds(stack, held, &targets, pushed);
         self.settle_on_walls(stack, held, &targets);
+        self.note_hold(stack, held, &targets);
+    }
+
+    /// Notes every ball of `stack` as held, with how fast the hold left a row of `held`
+    /// closing beyond its target where that exceeds the resting floor, or 0
+    /// ([`Groups::last_hold`]).
+    fn note_hold(&mut self, stack: &Stack<T, D>, held: &[usize], targets: &[T]) {
+        let fastest = (self.excess(stack, held, targets).into_iter()).fold(T::zero(), T::max);
+        let speed = if fastest > self.rules.floor {
+            fastest.to_f64()
+        } else {
+            0.0
+        };
+        for part in &stack.parts {
+            match part.side {
+                Side::Ball(i) => self.groups.held.push((i as u32, speed)),
+                Side::Cluster(c) => (self.groups.held)
+                    .extend(self.clusters.list[c].members.iter().map(|&m| (m, speed))),
+            }
+        }
     }
 
     /// Sets the chord of every free ball the hold left closing on a wall of the border,
