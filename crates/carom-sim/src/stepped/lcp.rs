@@ -86,7 +86,13 @@ pub(crate) struct Lcp {
     w: Vec<f64>,
     passive: Vec<usize>,
     excluded: Vec<bool>,
+    /// The Cholesky factor of the passive set's matrix, row `r` at `r * n` (the problem's
+    /// size, so that rows keep their places as the set changes).
     factor: Vec<f64>,
+    /// How many leading rows of `factor` hold the factor of the current passive set's
+    /// first contacts: a row depends only on the contacts before it, so a contact added
+    /// at the end costs one row, and one leaving costs the rows from its place on.
+    factored: usize,
     forward: Vec<f64>,
     /// The row of the factor whose pivot failed in the last [`Self::solve_passive`].
     dependent: Option<usize>,
@@ -129,6 +135,9 @@ impl Lcp {
         self.passive.clear();
         self.excluded.clear();
         self.excluded.resize(n, false);
+        self.factor.clear();
+        self.factor.resize(n * n, 0.0);
+        self.factored = 0;
         let scaled = |this: &Self, i: usize, j: usize| a[i * n + j] * this.scale[i] * this.scale[j];
         // The same test in scaled units for every contact: margin w_i / s_i (a speed).
         let closing = |this: &Self, i: usize| this.w[i] < -tolerance * this.scale[i];
@@ -154,11 +163,11 @@ impl Lcp {
             };
             self.passive.push(t);
             for _ in 0..=self.passive.len() {
-                if !self.solve_passive(&scaled, q) {
+                if !self.solve_passive(&scaled, q, n) {
                     // Dependent on the passive contacts: pushing on it moves nothing the
                     // others do not. Trade it for one of them along the null direction.
-                    if !self.exchange(t) {
-                        self.passive.retain(|&i| i != t);
+                    if !self.exchange(t, n) {
+                        self.leave(|&i| i != t);
                         self.excluded[t] = true;
                         break;
                     }
@@ -172,7 +181,7 @@ impl Lcp {
                 }
                 if self.z[t] <= 0.0 && self.mu[t] == 0.0 {
                     // Rounding: the contact that entered would not push after all.
-                    self.passive.retain(|&i| i != t);
+                    self.leave(|&i| i != t);
                     self.excluded[t] = true;
                     break;
                 }
@@ -192,14 +201,15 @@ impl Lcp {
                     self.mu[i] = mu + (self.z[i] - mu) * step;
                 }
                 self.mu[blocking] = 0.0;
-                let mu = &mut self.mu;
-                self.passive.retain(|&i| {
+                let mut mu = core::mem::take(&mut self.mu);
+                self.leave(|&i| {
                     if mu[i] > 0.0 {
                         return true;
                     }
                     mu[i] = 0.0;
                     false
                 });
+                self.mu = mu;
             }
         }
         for (l, (&m, &s)) in lambda.iter_mut().zip(self.mu.iter().zip(&self.scale)) {
@@ -223,7 +233,7 @@ impl Lcp {
     /// largest `τ` keeping `μ_P >= 0` brings a contact with `c_k > 0` to zero: it leaves,
     /// `t` takes its place, and the set is independent again. If no `c_k` is positive, no
     /// impulses of these contacts open `t` (its margin is inconsistent with theirs).
-    fn exchange(&mut self, t: usize) -> bool {
+    fn exchange(&mut self, t: usize, n: usize) -> bool {
         let p = self.passive.len();
         let r = p - 1;
         if self.dependent != Some(r) || self.passive[r] != t {
@@ -234,11 +244,11 @@ impl Lcp {
         c.clear();
         c.resize(r, 0.0);
         for k in (0..r).rev() {
-            let mut sum = self.factor[r * p + k];
+            let mut sum = self.factor[r * n + k];
             for (l, &cl) in c.iter().enumerate().take(r).skip(k + 1) {
-                sum -= self.factor[l * p + k] * cl;
+                sum -= self.factor[l * n + k] * cl;
             }
-            c[k] = sum / self.factor[k * p + k];
+            c[k] = sum / self.factor[k * n + k];
         }
         let mut leaving = None;
         let mut tau = 0.0;
@@ -261,36 +271,54 @@ impl Lcp {
         self.mu[self.passive[leaving]] = 0.0;
         self.mu[t] = tau;
         self.forward = c;
-        let mu = &self.mu;
-        self.passive.retain(|&i| i == t || mu[i] > 0.0);
+        let mu = core::mem::take(&mut self.mu);
+        self.leave(|&i| i == t || mu[i] > 0.0);
+        self.mu = mu;
         true
+    }
+
+    /// Keeps the passive contacts `keep` says, in order; the factor's rows from the first
+    /// that leaves on no longer hold (see `factored`).
+    fn leave(&mut self, mut keep: impl FnMut(&usize) -> bool) {
+        if let Some(first) = self.passive.iter().position(|i| !keep(i)) {
+            self.factored = self.factored.min(first);
+            self.passive.retain(keep);
+        }
     }
 
     /// `z_P = −(D A D)_PP⁻¹ (D q)_P` on the passive set by Cholesky, `z = 0` elsewhere;
     /// `false` if a pivot marks the last passive contact as dependent on the others.
-    fn solve_passive(&mut self, scaled: &impl Fn(&Self, usize, usize) -> f64, q: &[f64]) -> bool {
+    /// The rows of the factor from `factored` on are computed anew; the ones before are
+    /// the same numbers whether kept or computed again (a row reads only the rows before
+    /// it), so keeping them changes no result.
+    fn solve_passive(
+        &mut self,
+        scaled: &impl Fn(&Self, usize, usize) -> f64,
+        q: &[f64],
+        n: usize,
+    ) -> bool {
         let p = self.passive.len();
         self.dependent = None;
-        self.factor.clear();
-        self.factor.resize(p * p, 0.0);
         // L Lᵀ = (D A D)_PP, row by row (lower triangle).
-        for r in 0..p {
+        for r in self.factored.min(p)..p {
             for c in 0..=r {
                 let mut sum = scaled(self, self.passive[r], self.passive[c]);
                 for k in 0..c {
-                    sum -= self.factor[r * p + k] * self.factor[c * p + k];
+                    sum -= self.factor[r * n + k] * self.factor[c * n + k];
                 }
                 if r == c {
                     if sum <= DEPENDENCE_THRESHOLD {
                         self.dependent = Some(r);
+                        self.factored = r;
                         return false;
                     }
-                    self.factor[r * p + r] = sum.sqrt();
+                    self.factor[r * n + r] = sum.sqrt();
                 } else {
-                    self.factor[r * p + c] = sum / self.factor[c * p + c];
+                    self.factor[r * n + c] = sum / self.factor[c * n + c];
                 }
             }
         }
+        self.factored = p;
         self.z.iter_mut().for_each(|z| *z = 0.0);
         // Forward: L y = −(D q)_P; backward: Lᵀ z_P = y.
         let mut y = core::mem::take(&mut self.forward);
@@ -300,16 +328,16 @@ impl Lcp {
             let i = self.passive[r];
             let mut sum = -q[i] * self.scale[i];
             for (k, &yk) in y.iter().enumerate().take(r) {
-                sum -= self.factor[r * p + k] * yk;
+                sum -= self.factor[r * n + k] * yk;
             }
-            y[r] = sum / self.factor[r * p + r];
+            y[r] = sum / self.factor[r * n + r];
         }
         for r in (0..p).rev() {
             let mut sum = y[r];
             for k in r + 1..p {
-                sum -= self.factor[k * p + r] * self.z[self.passive[k]];
+                sum -= self.factor[k * n + r] * self.z[self.passive[k]];
             }
-            self.z[self.passive[r]] = sum / self.factor[r * p + r];
+            self.z[self.passive[r]] = sum / self.factor[r * n + r];
         }
         self.forward = y;
         true
