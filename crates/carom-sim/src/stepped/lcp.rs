@@ -81,14 +81,20 @@ pub(crate) const RESOLVABLE_MASS_RATIO: f64 = 1.0 / DEPENDENCE_THRESHOLD;
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Lcp {
     scale: Vec<f64>,
+    /// `D A D`, row-major: each entry computed once a solve.
+    scaled: Vec<f64>,
+    /// Whether each contact is in `passive`.
+    in_passive: Vec<bool>,
     mu: Vec<f64>,
     z: Vec<f64>,
     w: Vec<f64>,
     passive: Vec<usize>,
     excluded: Vec<bool>,
-    /// The Cholesky factor of the passive set's matrix, row `r` at `r * n` (the problem's
-    /// size, so that rows keep their places as the set changes).
+    /// The Cholesky factor `L` of the passive set's matrix, row `r` at `r * n` (the
+    /// problem's size, so that rows keep their places as the set changes).
     factor: Vec<f64>,
+    /// `Lᵀ` likewise, for the backward substitution to read along rows.
+    transposed: Vec<f64>,
     /// How many leading rows of `factor` hold the factor of the current passive set's
     /// first contacts: a row depends only on the contacts before it, so a contact added
     /// at the end costs one row, and one leaving costs the rows from its place on.
@@ -123,36 +129,22 @@ impl Lcp {
         self.largest = self.largest.max(n);
         debug_assert_eq!(a.len(), n * n);
         debug_assert_eq!(lambda.len(), n);
-        self.scale.clear();
-        self.scale
-            .extend((0..n).map(|i| 1.0 / a[i * n + i].max(f64::MIN_POSITIVE).sqrt()));
-        self.mu.clear();
-        self.mu.resize(n, 0.0);
-        self.z.clear();
-        self.z.resize(n, 0.0);
-        self.w.clear();
-        self.w.resize(n, 0.0);
-        self.passive.clear();
-        self.excluded.clear();
-        self.excluded.resize(n, false);
-        self.factor.clear();
-        self.factor.resize(n * n, 0.0);
-        self.factored = 0;
-        let scaled = |this: &Self, i: usize, j: usize| a[i * n + j] * this.scale[i] * this.scale[j];
+        self.start(a, n);
         // The same test in scaled units for every contact: margin w_i / s_i (a speed).
         let closing = |this: &Self, i: usize| this.w[i] < -tolerance * this.scale[i];
         // Each outer step adds a contact for good or excludes one; each inner step
         // removes one. Bounded well above what the theory needs, against rounding.
         for _ in 0..4 * n + 8 {
             for (i, &qi) in q.iter().enumerate() {
+                let row = &self.scaled[i * n..(i + 1) * n];
                 let mut wi = qi * self.scale[i];
                 for &j in &self.passive {
-                    wi += scaled(self, i, j) * self.mu[j];
+                    wi += row[j] * self.mu[j];
                 }
                 self.w[i] = wi;
             }
             let entering = (0..n)
-                .filter(|&i| !self.excluded[i] && !self.passive.contains(&i) && closing(self, i))
+                .filter(|&i| !self.excluded[i] && !self.in_passive[i] && closing(self, i))
                 .min_by(|&i, &j| {
                     self.w[i]
                         .partial_cmp(&self.w[j])
@@ -162,8 +154,9 @@ impl Lcp {
                 break;
             };
             self.passive.push(t);
+            self.in_passive[t] = true;
             for _ in 0..=self.passive.len() {
-                if !self.solve_passive(&scaled, q, n) {
+                if !self.solve_passive(q, n) {
                     // Dependent on the passive contacts: pushing on it moves nothing the
                     // others do not. Trade it for one of them along the null direction.
                     if !self.exchange(t, n) {
@@ -277,12 +270,46 @@ impl Lcp {
         true
     }
 
+    /// Empties the scratch for a problem of `n` contacts with matrix `a`: no contact
+    /// passive, no impulse, the scaling `D` and `D A D`.
+    fn start(&mut self, a: &[f64], n: usize) {
+        self.scale.clear();
+        self.scale
+            .extend((0..n).map(|i| 1.0 / a[i * n + i].max(f64::MIN_POSITIVE).sqrt()));
+        self.mu.clear();
+        self.mu.resize(n, 0.0);
+        self.z.clear();
+        self.z.resize(n, 0.0);
+        self.w.clear();
+        self.w.resize(n, 0.0);
+        self.passive.clear();
+        self.excluded.clear();
+        self.excluded.resize(n, false);
+        self.factor.clear();
+        self.factor.resize(n * n, 0.0);
+        self.transposed.clear();
+        self.transposed.resize(n * n, 0.0);
+        self.factored = 0;
+        self.in_passive.clear();
+        self.in_passive.resize(n, false);
+        self.scaled.clear();
+        self.scaled.extend((0..n * n).map(|k| {
+            let (i, j) = (k / n, k % n);
+            a[k] * self.scale[i] * self.scale[j]
+        }));
+    }
+
     /// Keeps the passive contacts `keep` says, in order; the factor's rows from the first
     /// that leaves on no longer hold (see `factored`).
     fn leave(&mut self, mut keep: impl FnMut(&usize) -> bool) {
         if let Some(first) = self.passive.iter().position(|i| !keep(i)) {
             self.factored = self.factored.min(first);
-            self.passive.retain(keep);
+            let in_passive = &mut self.in_passive;
+            self.passive.retain(|i| {
+                let kept = keep(i);
+                in_passive[*i] = kept;
+                kept
+            });
         }
     }
 
@@ -291,31 +318,29 @@ impl Lcp {
     /// The rows of the factor from `factored` on are computed anew; the ones before are
     /// the same numbers whether kept or computed again (a row reads only the rows before
     /// it), so keeping them changes no result.
-    fn solve_passive(
-        &mut self,
-        scaled: &impl Fn(&Self, usize, usize) -> f64,
-        q: &[f64],
-        n: usize,
-    ) -> bool {
+    fn solve_passive(&mut self, q: &[f64], n: usize) -> bool {
         let p = self.passive.len();
         self.dependent = None;
         // L Lᵀ = (D A D)_PP, row by row (lower triangle).
         for r in self.factored.min(p)..p {
+            let row = self.passive[r] * n;
             for c in 0..=r {
-                let mut sum = scaled(self, self.passive[r], self.passive[c]);
+                let mut sum = self.scaled[row + self.passive[c]];
                 for k in 0..c {
                     sum -= self.factor[r * n + k] * self.factor[c * n + k];
                 }
-                if r == c {
+                let entry = if r == c {
                     if sum <= DEPENDENCE_THRESHOLD {
                         self.dependent = Some(r);
                         self.factored = r;
                         return false;
                     }
-                    self.factor[r * n + r] = sum.sqrt();
+                    sum.sqrt()
                 } else {
-                    self.factor[r * n + c] = sum / self.factor[c * n + c];
-                }
+                    sum / self.factor[c * n + c]
+                };
+                self.factor[r * n + c] = entry;
+                self.transposed[c * n + r] = entry;
             }
         }
         self.factored = p;
@@ -335,7 +360,7 @@ impl Lcp {
         for r in (0..p).rev() {
             let mut sum = y[r];
             for k in r + 1..p {
-                sum -= self.factor[k * n + r] * self.z[self.passive[k]];
+                sum -= self.transposed[r * n + k] * self.z[self.passive[k]];
             }
             self.z[self.passive[r]] = sum / self.factor[r * n + r];
         }
