@@ -285,10 +285,12 @@ impl Lcp {
         self.passive.clear();
         self.excluded.clear();
         self.excluded.resize(n, false);
-        self.factor.clear();
-        self.factor.resize(n * n, 0.0);
-        self.transposed.clear();
-        self.transposed.resize(n * n, 0.0);
+        // Every entry of the factor a solve reads it wrote first (rows below `factored`),
+        // so the scratch is only grown, not cleared.
+        if self.factor.len() < n * n {
+            self.factor.resize(n * n, 0.0);
+            self.transposed.resize(n * n, 0.0);
+        }
         self.factored = 0;
         self.in_passive.clear();
         self.in_passive.resize(n, false);

@@ -266,10 +266,11 @@ pub(crate) struct Groups {
     of: Vec<u32>,
     /// Per group: its balls (a cluster's members all).
     balls: Vec<Vec<u32>>,
-    /// The balls held in this step, in the order of their holds, each with how fast its
-    /// hold left a row closing beyond its target where that exceeded the resting floor
-    /// (the fastest of its rows), or 0: for a crush error (see [`Groups::last_hold`]).
-    held: Vec<(u32, f64)>,
+    /// Per ball: what its last hold in this step left ([`Groups::last_hold`]), `None` if
+    /// no hold took it in. One entry per ball, however many holds a step makes.
+    last_hold: Vec<Option<f64>>,
+    /// The balls with an entry in `last_hold`, to forget at the step's start.
+    held: Vec<u32>,
 }
 
 /// A ball in no group.
@@ -281,6 +282,7 @@ impl Groups {
         Self {
             of: vec![NONE; n],
             balls: Vec::new(),
+            last_hold: vec![None; n],
             held: Vec::new(),
         }
     }
@@ -293,6 +295,9 @@ impl Groups {
             }
         }
         self.balls.clear();
+        for &b in &self.held {
+            self.last_hold[b as usize] = None;
+        }
         self.held.clear();
     }
 
@@ -307,9 +312,17 @@ impl Groups {
     /// impulse (fuzzed: a cluster's member between the left wall and a box's face closing
     /// on it at 35 m/s, crushed without a hold in that step).
     pub(crate) fn last_hold(&self, i: usize) -> Option<f64> {
-        (self.held.iter().rev())
-            .find(|&&(b, _)| b as usize == i)
-            .map(|&(_, speed)| speed)
+        self.last_hold[i]
+    }
+
+    /// Notes that ball `b` was held, the hold leaving a row closing at `speed` (see
+    /// [`Groups::last_hold`]).
+    fn note_held(&mut self, b: u32, speed: f64) {
+        let entry = &mut self.last_hold[b as usize];
+        if entry.is_none() {
+            self.held.push(b);
+        }
+        *entry = Some(speed);
     }
 
     /// Prefetches ball `i`'s group (see `prefetch`): every contact reads it.
@@ -642,9 +655,12 @@ where
         };
         for part in &stack.parts {
             match part.side {
-                Side::Ball(i) => self.groups.held.push((i as u32, speed)),
-                Side::Cluster(c) => (self.groups.held)
-                    .extend(self.clusters.list[c].members.iter().map(|&m| (m, speed))),
+                Side::Ball(i) => self.groups.note_held(i as u32, speed),
+                Side::Cluster(c) => {
+                    for &m in &self.clusters.list[c].members {
+                        self.groups.note_held(m, speed);
+                    }
+                }
             }
         }
     }
