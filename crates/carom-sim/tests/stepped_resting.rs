@@ -13,8 +13,12 @@ mod common;
 use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;
 use carom_sim::Simulation;
+use carom_sim::observe;
 use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
-use common::{Recorder, assert_stays_put, spanning_the_origin, states, stepped};
+use common::{
+    Recorder, assert_stays_put, deepest_overlap, outside_border, spanning_the_origin, states,
+    stepped,
+};
 use nalgebra::Vector2;
 
 const G: f64 = 9.81;
@@ -532,4 +536,101 @@ fn balls_moving_together_fast_closing_within_their_speeds_rounding_do_not_sink_i
 fn a_ball_riding_a_fast_box_closing_within_their_speeds_rounding_does_not_sink_into_it() {
     assert_moving_together_does_not_sink::<f32>(50.0, true);
     assert_moving_together_does_not_sink::<f64>(5e5, true);
+}
+
+/// A packed pyramid of 212 balls (30 at the base, 8 rows) between walls: its 500-odd
+/// resting contacts are one pile, held at each step's start as one stack, a problem
+/// beyond the exact solver's size that the sparse one solves (`sparse_lcp`). It stays
+/// put to 1e-9 m, 1e-9 m/s and 1e-9 of its energy, as the smaller pyramids above do
+/// with the exact solver.
+#[test]
+fn a_packed_pyramid_too_large_for_the_exact_solver_stays_put() {
+    let s = pyramid(6.0, 8, 0.0);
+    assert_eq!(s.balls.len(), 212);
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, 1.0 / 600.0);
+    let start = states(&sim);
+    let mut rec = Recorder::default();
+    assert_stays_put(
+        &mut sim,
+        &s,
+        &start.pos,
+        1.0,
+        10,
+        1e-9,
+        &mut rec,
+        "212 balls",
+    );
+    assert!(rec.collisions.is_empty(), "{:?}", &rec.collisions[..1]);
+    let largest = sim.stats().largest_hold;
+    assert!(largest > 256, "the largest hold took {largest} contacts");
+}
+
+/// 96 balls of 0.5 to 2 kg dropped in 6 rows of 16 into a box 10 m wide (restitution
+/// 0.2, friction 0.3; the first rows of `docs/open-scenes`' pile of 480): as the rows
+/// land on each other they form one pile, held at each step's start as one stack, and
+/// balls landing on it meet it as a surface (shock propagation). Every step: no ball
+/// outside the box beyond 1e-9 m, none overlapping another beyond what the narrow phase
+/// allows (a contact closing slower than a millionth of `g h` sinks for the rest of the
+/// step: 2.7e-9 m, plus both balls' touch tolerance, 2.7e-10 m each), and the energy
+/// (kinetic and potential) never above the last step's beyond what that allowance
+/// lets the pile's weight do (every ball lifted by it: `M g` times 2.7e-9 m, 3.2e-6 J);
+/// after 4 s the pile is at rest (every ball slower than 1 cm/s).
+#[test]
+fn a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest() {
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut uniform = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1_u64 << 53) as f64
+    };
+    let mut balls = Vec::new();
+    for row in 0..6 {
+        for k in 0..16 {
+            let x = -4.7 + 0.625 * f64::from(k) + 0.1 * (uniform() - 0.5);
+            let vel = Vector2::new(2.0 * uniform() - 1.0, 0.0);
+            let pos = Vector2::new(x, 0.5 + 0.6 * f64::from(row));
+            balls.push(BallSpec::new(pos, vel, 0.25, 0.5 + 1.5 * uniform()));
+        }
+    }
+    let mut world = floor_world(0.2, 0.3, 10.0);
+    world.border.as_mut().unwrap().border =
+        Border::new(Vector2::new(-5.0, 0.0), Vector2::new(5.0, 30.0)).unwrap();
+    let s = Scene {
+        world,
+        balls,
+        ..Scene::default()
+    };
+    let dt = 1.0 / 60.0;
+    let touch = 1e-9 * 0.25 + 16.0 * f64::EPSILON * (5.0 + 0.25);
+    let sink = 1e-6 * G * dt * dt;
+    let allowance = sink + 2.0 * touch;
+    let weight: f64 = s.balls.iter().map(|b| b.mass * G).sum();
+    let mut sim = stepped(&s, Integrator::SemiImplicitEuler, dt);
+    let mut before = observe::energy(&s, &states(&sim));
+    for k in 1..=240 {
+        sim.advance_to(f64::from(k) * dt, &mut ()).unwrap();
+        let st = states(&sim);
+        let (outside, overlap) = (outside_border(&s, &st), deepest_overlap(&s, &st));
+        assert!(outside <= 1e-9, "step {k}: a ball {outside:e} m outside");
+        assert!(
+            overlap <= allowance,
+            "step {k}: two balls overlap by {overlap:e} m"
+        );
+        let e = observe::energy(&s, &st);
+        assert!(
+            e <= before + weight * sink,
+            "step {k}: energy {before} -> {e}"
+        );
+        before = e;
+    }
+    let st = states(&sim);
+    let fastest = st
+        .vel
+        .iter()
+        .map(nalgebra::Matrix::norm)
+        .fold(0.0, f64::max);
+    assert!(fastest < 0.01, "a ball still moves at {fastest} m/s");
+    let largest = sim.stats().largest_hold;
+    assert!(largest > 64, "the largest hold took {largest} contacts");
 }

@@ -130,6 +130,46 @@ impl Lcp {
         debug_assert_eq!(a.len(), n * n);
         debug_assert_eq!(lambda.len(), n);
         self.start(a, n);
+        self.iterate(q, tolerance);
+        self.finish(a, q, tolerance, lambda)
+    }
+
+    /// Solves the problem of the last [`Self::solve`] or `resolve` again with the same
+    /// matrix and a new `q`, starting from the last solution's passive set, its factor
+    /// and impulses: the friction rounds of a hold change only `q`, and a passive set
+    /// that still holds costs two triangular solves instead of a factorisation. The
+    /// result is the same solution (the margins are unique), to rounding.
+    pub(crate) fn resolve(
+        &mut self,
+        a: &[f64],
+        q: &[f64],
+        tolerance: f64,
+        lambda: &mut [f64],
+    ) -> bool {
+        let n = q.len();
+        debug_assert_eq!(self.scale.len(), n);
+        self.excluded.iter_mut().for_each(|e| *e = false);
+        // The last passive set for the new margins: walked back from the last impulses
+        // (all positive on it) while a passive impulse would turn negative.
+        for _ in 0..=self.passive.len() {
+            if self.passive.is_empty() || !self.solve_passive(q, n) {
+                break;
+            }
+            if self.passive.iter().all(|&i| self.z[i] > 0.0) {
+                for &i in &self.passive {
+                    self.mu[i] = self.z[i];
+                }
+                break;
+            }
+            self.walk_back(None);
+        }
+        self.iterate(q, tolerance);
+        self.finish(a, q, tolerance, lambda)
+    }
+
+    /// The active-set iterations from the current passive set and impulses.
+    fn iterate(&mut self, q: &[f64], tolerance: f64) {
+        let n = q.len();
         // The same test in scaled units for every contact: margin w_i / s_i (a speed).
         let closing = |this: &Self, i: usize| this.w[i] < -tolerance * this.scale[i];
         // Each outer step adds a contact for good or excludes one; each inner step
@@ -178,33 +218,45 @@ impl Lcp {
                     self.excluded[t] = true;
                     break;
                 }
-                // Walk from μ towards z until the first passive entry reaches zero; it
-                // leaves the set (with any other that rounding left at zero).
-                let (mut step, mut blocking) = (1.0, t);
-                for &i in &self.passive {
-                    if self.z[i] <= 0.0 {
-                        let reach = self.mu[i] / (self.mu[i] - self.z[i]);
-                        if reach < step {
-                            (step, blocking) = (reach, i);
-                        }
-                    }
-                }
-                for &i in &self.passive {
-                    let mu = self.mu[i];
-                    self.mu[i] = mu + (self.z[i] - mu) * step;
-                }
-                self.mu[blocking] = 0.0;
-                let mut mu = core::mem::take(&mut self.mu);
-                self.leave(|&i| {
-                    if mu[i] > 0.0 {
-                        return true;
-                    }
-                    mu[i] = 0.0;
-                    false
-                });
-                self.mu = mu;
+                self.walk_back(Some(t));
             }
         }
+    }
+
+    /// Walks from μ towards z until the first passive entry reaches zero; it leaves the
+    /// set (with any other that rounding left at zero). `entering`: the contact that
+    /// entered last, the blocking one where no other blocks first.
+    fn walk_back(&mut self, entering: Option<usize>) {
+        let (mut step, mut blocking) = (1.0, entering);
+        for &i in &self.passive {
+            if self.z[i] <= 0.0 {
+                let reach = self.mu[i] / (self.mu[i] - self.z[i]);
+                if reach < step || blocking.is_none() {
+                    (step, blocking) = (reach, Some(i));
+                }
+            }
+        }
+        for &i in &self.passive {
+            let mu = self.mu[i];
+            self.mu[i] = mu + (self.z[i] - mu) * step;
+        }
+        if let Some(b) = blocking {
+            self.mu[b] = 0.0;
+        }
+        let mut mu = core::mem::take(&mut self.mu);
+        self.leave(|&i| {
+            if mu[i] > 0.0 {
+                return true;
+            }
+            mu[i] = 0.0;
+            false
+        });
+        self.mu = mu;
+    }
+
+    /// Writes the impulses into `lambda`; whether every margin is above `−tolerance`.
+    fn finish(&self, a: &[f64], q: &[f64], tolerance: f64, lambda: &mut [f64]) -> bool {
+        let n = q.len();
         for (l, (&m, &s)) in lambda.iter_mut().zip(self.mu.iter().zip(&self.scale)) {
             *l = m * s;
         }
@@ -517,6 +569,50 @@ mod tests {
                     (l - e).abs() <= 1e-9 * (1.0 + e.abs()),
                     "trial {trial}: {lambda:?} vs {expected:?}"
                 );
+            }
+        }
+    }
+
+    /// A solve again with the same matrix and new margins (as a hold's friction rounds
+    /// make them), from the last passive set, gives what a solve from scratch gives:
+    /// the same margins, complementary impulses; dependent contacts included.
+    #[test]
+    fn a_solve_again_from_the_last_passive_set_matches_a_solve_from_scratch() {
+        let mut rng = Numbers::new(23);
+        let (mut again, mut fresh) = (Lcp::default(), Lcp::default());
+        for trial in 0..300 {
+            let m = 2 + trial % 6;
+            let n = 1 + trial % 9;
+            let j: Vec<f64> = (0..n * m).map(|_| rng.next()).collect();
+            let w: Vec<f64> = (0..m).map(|_| 0.5 + rng.next().abs()).collect();
+            let a = delassus(&j, &w, n, m);
+            // Feasible margins (q = −A λ* + s, λ*, s >= 0), moved each round.
+            let star: Vec<f64> = (0..n).map(|_| rng.next().max(0.0)).collect();
+            let pushed = margins(&a, &vec![0.0; n], &star);
+            let mut q: Vec<f64> = (0..n).map(|i| -pushed[i] + rng.next().max(0.0)).collect();
+            let mut lambda = vec![0.0; n];
+            assert!(again.solve(&a, &q, 1e-12, &mut lambda), "trial {trial}");
+            for round in 0..4 {
+                // Either way where every set of contacts is independent (`n <= m`: a
+                // solution exists for any margins); only opening otherwise.
+                for (qi, p) in q.iter_mut().zip(&pushed) {
+                    let d = rng.next();
+                    *qi += 0.1 * if n > m { d.abs() } else { d } * (1.0 + p.abs());
+                }
+                let mut expected = vec![0.0; n];
+                assert!(fresh.solve(&a, &q, 1e-12, &mut expected), "trial {trial}");
+                assert!(
+                    again.resolve(&a, &q, 1e-12, &mut lambda),
+                    "trial {trial}.{round}"
+                );
+                assert_complementary(&a, &q, &lambda, trial);
+                let (w, w_expected) = (margins(&a, &q, &lambda), margins(&a, &q, &expected));
+                for (x, y) in w.iter().zip(&w_expected) {
+                    assert!(
+                        (x - y).abs() <= 1e-9,
+                        "trial {trial}.{round}: {w:?} vs {w_expected:?}"
+                    );
+                }
             }
         }
     }

@@ -47,9 +47,11 @@ mod forces;
 mod lcp;
 mod narrow;
 mod obstacles;
+mod piles;
 mod queue;
 mod response;
 mod rest;
+mod sparse_lcp;
 mod stack;
 mod stick;
 mod sweep;
@@ -65,13 +67,12 @@ use rayon::prelude::*;
 use self::balls::BallArrays;
 use self::clusters::{Clusters, Flight};
 use self::forces::WorldForces;
-use self::lcp::Lcp;
 use self::narrow::{Event, Narrow, Overflow, Target, apart_speed, touch_tolerance};
 use self::obstacles::BoxArrays;
 use self::queue::EventQueue;
 use self::response::{Contacts, Effect, RestSets, Rules, Surface};
 use self::rest::{Support, Touch};
-use self::stack::{Groups, SeedOther};
+use self::stack::{Groups, SeedOther, Solvers};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
 use self::wedge::{Repeat, Repeats, WEDGE_CONTACTS, wedge_limit};
 
@@ -136,7 +137,8 @@ pub struct StepStats {
     /// counted in [`Self::steps`] too.
     pub substeps: u64,
     /// The most contacts held together in one complementarity problem (a stack's hold,
-    /// see `docs/stepped.md`): its cost grows with the cube of this.
+    /// see `docs/stepped.md`): up to 256 the problem is solved exactly, at a cost that
+    /// grows with the cube of this; beyond, by projected conjugate gradients.
     pub largest_hold: u64,
     /// Steps that exhausted the event budget (see [`SteppedEngine::set_event_budget`]).
     pub capped_steps: u64,
@@ -189,8 +191,8 @@ where
     /// Events of one ball's prediction (scratch).
     found: Vec<Event<T, D>>,
     touches: [Vec<Touch<T, D>>; 2],
-    /// Scratch of the stacks' complementarity problems (see `stack`).
-    lcp: Lcp,
+    /// The stacks' complementarity solvers and what they keep (see `stack`).
+    solvers: Solvers<D>,
     /// The bodies held together in the current step (see `stack`).
     groups: Groups,
     /// Each ball's contacts at one instant in the current step (see `wedge`).
@@ -341,7 +343,7 @@ where
             candidates: Vec::new(),
             found: Vec::new(),
             touches: [Vec::new(), Vec::new()],
-            lcp: Lcp::default(),
+            solvers: Solvers::default(),
             groups: Groups::new(n),
             repeats: Repeats::new(n),
             clock: Clock {
@@ -413,7 +415,7 @@ where
     pub fn stats(&self) -> StepStats {
         StepStats {
             broad_builds: self.sweep.builds(),
-            largest_hold: self.lcp.largest() as u64,
+            largest_hold: self.solvers.largest() as u64,
             ..self.stats
         }
     }
@@ -487,6 +489,7 @@ where
         };
         self.rest.clear();
         self.groups.clear();
+        self.solvers.warm.next_step();
         self.repeats.clear();
         let stepper = &self.stepper;
         let previous = self.step_length;
@@ -814,33 +817,28 @@ where
         let grouped_i = self.groups.grouped(i);
         let wedged = self.note_contacts(e, h, t0)?;
         self.changed.clear();
-        let mut contacts = Contacts {
-            balls: &mut self.balls,
-            changed: &mut self.changed,
-            boxes: &self.boxes,
-            border: self.border.as_ref(),
-            periodic: self.periodic.as_ref(),
-            sweep: &self.sweep,
-            candidates: &mut self.candidates,
-            lcp: &mut self.lcp,
-            groups: &mut self.groups,
-            stepper: &self.stepper,
-            rules: &self.rules,
-            rest: &mut self.rest,
-            clusters: &mut self.clusters,
-            touching: [(i, &touches[0]), (other, &touches[1])],
-            h,
-            t0,
-        };
         let time = (t0 + e.time) * self.clock.sign + T::zero();
+        let stick = self.rules.stick;
+        let box_velocity = |k: usize| self.boxes.vel[k];
+        let surface = match e.target {
+            Target::Box(k) => Surface::Box(k as usize, box_velocity(k as usize)),
+            Target::Border | Target::Ball(_) => Surface::Wall,
+        };
+        let mut contacts = self.contacts([(i, &touches[0]), (other, &touches[1])], h, t0);
         let stuck_error = |message: String| SimError::new(time.to_f64(), message);
         let (effect, collision): (Effect, Collision<T>) = match e.target {
             Target::Ball(j) => {
                 let j = j as usize;
-                let sticks = self.rules.stick && contacts.balls.pair_restitution(i, j) == T::zero();
+                let sticks = stick && contacts.balls.pair_restitution(i, j) == T::zero();
                 let grouped = contacts.groups.grouped(i) || contacts.groups.grouped(j);
+                let onto_pile = (grouped && !clustered && !sticks)
+                    .then(|| contacts.onto_held_pile(i, j, e.time))
+                    .flatten();
                 let effect = if wedged && !clustered && !sticks {
                     contacts.wedged(i, SeedOther::Ball(j), e.time)
+                } else if let Some((upper, lower)) = onto_pile {
+                    let n = if upper == i { e.normal } else { -e.normal };
+                    contacts.onto_pile(upper, lower, &n, e.time)
                 } else if clustered || sticks || grouped {
                     contacts
                         .stuck_pair(i, j, &e.shift, e.time, &e.normal)
@@ -851,13 +849,13 @@ where
                 (effect, Collision::BallBall { time, i, j })
             }
             Target::Border | Target::Box(_) => {
-                let (surface, collision) = match e.target {
-                    Target::Box(k) => {
-                        let k = k as usize;
-                        let surface = Surface::Box(k, self.boxes.vel[k]);
-                        (surface, Collision::BallBox { time, i, k })
-                    }
-                    _ => (Surface::Wall, Collision::BallBorder { time, i }),
+                let collision = match e.target {
+                    Target::Box(k) => Collision::BallBox {
+                        time,
+                        i,
+                        k: k as usize,
+                    },
+                    _ => Collision::BallBorder { time, i },
                 };
                 let effect = if wedged && !clustered {
                     contacts.wedged(i, SeedOther::Surface(e.normal), e.time)
@@ -892,6 +890,57 @@ where
             }
             collision
         }))
+    }
+
+    /// The engine's balls, bodies and rules for answering contacts in the step of length
+    /// `h` from internal time `t0`, with the supports the contact's balls touch.
+    fn contacts<'a>(
+        &'a mut self,
+        touching: [(usize, &'a [Touch<T, D>]); 2],
+        h: T,
+        t0: T,
+    ) -> Contacts<'a, T, D, WorldForces<T, D>> {
+        Contacts {
+            balls: &mut self.balls,
+            changed: &mut self.changed,
+            boxes: &self.boxes,
+            border: self.border.as_ref(),
+            periodic: self.periodic.as_ref(),
+            sweep: &self.sweep,
+            candidates: &mut self.candidates,
+            solvers: &mut self.solvers,
+            groups: &mut self.groups,
+            stepper: &self.stepper,
+            rules: &self.rules,
+            rest: &mut self.rest,
+            clusters: &mut self.clusters,
+            touching,
+            h,
+            t0,
+        }
+    }
+
+    /// Holds every large pile at the step's start as one stack (see `piles`), under
+    /// gravity: its contacts answered one at a time would each hold it again.
+    fn hold_piles(&mut self, h: T, t0: T) {
+        if self.rules.gravity == Vector::<T, D>::zeros() {
+            return;
+        }
+        let piles = piles::resting_piles(
+            &self.balls,
+            &self.boxes,
+            self.border.as_ref(),
+            self.periodic.as_ref(),
+            &self.sweep.pairs,
+            h,
+            self.rules.support_speed,
+        );
+        for pile in &piles {
+            self.contacts([(usize::MAX, &[]), (usize::MAX, &[])], h, t0)
+                .hold_resting(pile);
+            self.groups.note_pile(pile);
+        }
+        self.changed.clear();
     }
 
     /// The supports ball `i` touches at in-step time `s` (within `1e-9` of its radius):
@@ -1418,8 +1467,6 @@ where
             if first {
                 self.sweep
                     .begin_step(&self.balls, &self.boxes, h, self.escape_bound, parallel);
-                self.predict_all(a, b, parallel)
-                    .map_err(|o| self.overflow(o, t0 + a))?;
             } else {
                 let reach = if self.periodic.is_some() {
                     b - a
@@ -1429,9 +1476,12 @@ where
                 };
                 self.sweep
                     .build(&self.balls, &self.boxes, a, reach, parallel);
-                self.predict_all(a, b, parallel)
-                    .map_err(|o| self.overflow(o, t0 + a))?;
             }
+            if a == T::zero() {
+                self.hold_piles(h, t0);
+            }
+            self.predict_all(a, b, parallel)
+                .map_err(|o| self.overflow(o, t0 + a))?;
             first = false;
             let ended = awake::hold_pool(parallel, || {
                 self.run_window(b, h, t0, &mut step_contacts, observer)

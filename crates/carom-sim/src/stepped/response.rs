@@ -44,12 +44,11 @@ use carom_response::{Body, Coefficients, Contact, Response, normal_velocity, res
 use nalgebra::Const;
 
 use super::balls::{BallArrays, SegmentEnd};
-use super::clusters::{Clusters, Flight};
-use super::lcp::Lcp;
+use super::clusters::{Clusters, FREE, Flight};
 use super::narrow::{Allowance, Target, apart_speed, touch_tolerance};
 use super::obstacles::BoxArrays;
 use super::rest::{RestSet, Support, Touch};
-use super::stack::Groups;
+use super::stack::{Groups, Solvers};
 use super::sweep::Sweep;
 use crate::engine::Angular;
 use crate::prefetch::prefetch;
@@ -266,8 +265,8 @@ where
     pub(crate) sweep: &'a Sweep<T, D>,
     /// Scratch for the broad phase's candidates.
     pub(crate) candidates: &'a mut Vec<u32>,
-    /// Scratch of a stack's complementarity problems.
-    pub(crate) lcp: &'a mut Lcp,
+    /// The stacks' complementarity solvers (see `stack`).
+    pub(crate) solvers: &'a mut Solvers<D>,
     /// The bodies held together in this step (see `stack`).
     pub(crate) groups: &'a mut Groups,
     /// The supports the contact's balls touch now: `(ball, touches)` (gathered only
@@ -618,6 +617,68 @@ where
             &Coefficients::new_unchecked(e, self.rules.friction),
         );
         r.applied().then_some(r)
+    }
+
+    /// Of balls `i` and `j` meeting at `s`, the one that meets a held ball of a pile from
+    /// above, and that ball: `(upper, lower)`, where the lower one is in a pile held at
+    /// the step's start (see `piles`) and holds the upper one up
+    /// ([`Contacts::holds_up`]).
+    pub(crate) fn onto_held_pile(&self, i: usize, j: usize, s: T) -> Option<(usize, usize)> {
+        let onto = |upper: usize, lower: usize| {
+            self.groups.piled(lower)
+                && self.balls.cluster[upper] == FREE
+                && self.holds_up(upper, lower, s)
+        };
+        if onto(i, j) {
+            Some((i, j))
+        } else if onto(j, i) {
+            Some((j, i))
+        } else {
+            None
+        }
+    }
+
+    /// Ball `upper` meeting ball `lower` of a held pile below it at `s` (see
+    /// [`Self::onto_held_pile`]; `n` the unit normal from `upper` into `lower`): the pile's
+    /// ball is an immovable surface moving at its chord (shock propagation), so the
+    /// collision and the rest that follows change `upper` alone, and the pile keeps its
+    /// hold.
+    ///
+    /// A pile rests on the floor, and its balls' weight and every push they take goes
+    /// down to it: a ball landing on it meets, in effect, a body as heavy as the pile and
+    /// the floor. Answered between the two balls alone, the struck ball was pushed into
+    /// the pile, which had to be held again as a whole, at every bounce of every ball
+    /// landing on it: a 480-ball pile made several hundred holds of hundreds of balls a
+    /// step while its rows landed.
+    pub(crate) fn onto_pile(
+        &mut self,
+        upper: usize,
+        lower: usize,
+        n: &Vector<T, D>,
+        s: T,
+    ) -> Effect {
+        let h = self.h;
+        self.balls.restart(upper, s, h);
+        let b = &*self.balls;
+        let spin = b.seg_w[lower];
+        let surface = b.chord[lower]
+            + <Const<D> as Space<T, D>>::angular_cross(&spin, &(n * -b.radius[lower]));
+        let zero_spin = <Const<D> as Space<T, D>>::angular_zero();
+        let other = Body::kinematic(surface, zero_spin).unwrap_or_else(|_| Body::fixed());
+        let Ok(contact) = Contact::new(*n, n * b.radius[upper], Vector::zeros()) else {
+            return Effect::default();
+        };
+        let ball = self.body(upper, b.seg_v[upper], b.seg_w[upper]);
+        let nominal = b.pair_restitution(upper, lower);
+        let mut effect = Effect::default();
+        if let Some(r) = self.surface_collision(&ball, &other, &contact, nominal) {
+            effect.collided = true;
+            self.collide(upper, s, r.velocity[0], r.angular_velocity[0]);
+        }
+        if (surface - self.balls.chord[upper]).dot(n) < T::zero() && s < h {
+            self.rest_on(upper, Support::Ball(lower as u32), n, surface, zero_spin, s);
+        }
+        effect
     }
 
     /// Ball `i` touching a wall or a box along `n` (from the ball into the surface) at `s`.

@@ -42,7 +42,18 @@
 //! beyond its margin, and leave none closing), whatever the mass ratios: a cluster a
 //! million times heavier than the one it rests on is held in one solve. With friction the
 //! normal impulses and the tangential ones (Coulomb's cone, projected Gauss–Seidel) are
-//! solved in turn until they agree (staggered projections).
+//! solved in turn until they agree (staggered projections); each round after the first
+//! solves again from the last one's passive set (`Lcp::resolve`: only the margins
+//! changed).
+//!
+//! **Piles.** Under gravity a pile of free balls (more than `piles::PILE_CONTACTS`
+//! resting contacts) is held whole at the step's start ([`Approach::Resting`]: its free
+//! balls bring in every free ball they touch or could reach in the step at twice the
+//! speed of support, and its touching collisions with restitution below 1 are answered
+//! in its impacts at once, each parting at `e` times its approach), and again the same
+//! way after a contact of one of its balls. A hold of more than [`SPARSE_ROWS`] rows is
+//! solved sparsely (`sparse`, `sparse_lcp`: projected conjugate gradients, to a
+//! tolerance, not exactly, started from the forces the same rows took last).
 //!
 //! **Rotations.** A cluster's chords follow its rotation over the rest of the step, which
 //! the problem sees to first order (`Δu = ΔV + ΔΩ × a`). What the first order leaves
@@ -69,9 +80,15 @@ use nalgebra::Const;
 
 use carom_response::RigidCluster;
 
+mod sparse;
+
+pub(crate) use sparse::{SPARSE_ROWS, Warm};
+
 use super::clusters::{FREE, Flight, Motion};
+use super::lcp::Lcp;
 use super::narrow::{Allowance, Target, sunk, time_resolved_gap, touch_tolerance};
 use super::response::{Contacts, Effect};
+use super::sparse_lcp::{SparseLcp, SparseMatrix};
 use super::stick::Side;
 use super::sweep::path_box;
 use crate::engine::Angular;
@@ -198,7 +215,17 @@ where
     fn wedge_step(&self, h: T) -> T {
         match self.approach {
             Approach::Any => h,
-            Approach::Slow => T::zero(),
+            Approach::Slow | Approach::Resting => T::zero(),
+        }
+    }
+
+    /// The Delassus matrix of `rows`, dense up to [`SPARSE_ROWS`] rows, sparse beyond
+    /// (see `sparse`).
+    fn delassus(&self, rows: &[usize], push: Push) -> Delassus {
+        if rows.len() > SPARSE_ROWS {
+            Delassus::Sparse(self.sparse_delassus(rows, push))
+        } else {
+            Delassus::Dense(self.dense_delassus(rows, push))
         }
     }
 
@@ -207,41 +234,44 @@ where
     /// how a unit push along row `d`'s normal changes the approach at row `c`; pushed
     /// through the centres of mass, the angular term drops. The linear term and the sum
     /// over bodies are computed in `f64`, the angular term in `T` (see [`Wide`]).
-    fn delassus(&self, rows: &[usize], push: Push) -> Vec<f64> {
+    fn dense_delassus(&self, rows: &[usize], push: Push) -> Vec<f64> {
         let n = rows.len();
         let mut a = vec![0.0; n * n];
         for (r, &c) in rows.iter().enumerate() {
             for (q, &d) in rows.iter().enumerate().skip(r) {
-                let (nc, nd) = (&self.rows[c].normal, &self.rows[d].normal);
-                let mut sum = 0.0;
-                for (ec, sc) in self.ends(c) {
-                    for (ed, sd) in self.ends(d).filter(|(e, _)| e.part == ec.part) {
-                        let part = &self.parts[ec.part];
-                        let angular = match push {
-                            Push::ThroughCentres => T::zero(),
-                            Push::AtContacts => {
-                                let ac = <Const<D> as Space<T, D>>::cross(&ec.arm, nc);
-                                let ad = <Const<D> as Space<T, D>>::cross(&ed.arm, nd);
-                                <Const<D> as Space<T, D>>::angular_dot(
-                                    &ac,
-                                    &<Const<D> as Space<T, D>>::inertia_apply(
-                                        &part.inverse_inertia,
-                                        &ad,
-                                    ),
-                                )
-                            }
-                        };
-                        // The linear term in `f64` too: rounded in `f32`, `n_c·n_d/m`
-                        // of the light ball hid the heavy ball's part (see `Wide`).
-                        let linear = wide(nc).dot(&wide(nd)) * part.inverse_mass.to_f64();
-                        sum += (sc * sd).to_f64() * (linear + angular.to_f64());
-                    }
-                }
+                let sum = self.coupling(c, d, push);
                 a[r * n + q] = sum;
                 a[q * n + r] = sum;
             }
         }
         a
+    }
+
+    /// The entry of rows `c` and `d` of the Delassus matrix (see [`Self::delassus`]).
+    fn coupling(&self, c: usize, d: usize, push: Push) -> f64 {
+        let (nc, nd) = (&self.rows[c].normal, &self.rows[d].normal);
+        let mut sum = 0.0;
+        for (ec, sc) in self.ends(c) {
+            for (ed, sd) in self.ends(d).filter(|(e, _)| e.part == ec.part) {
+                let part = &self.parts[ec.part];
+                let angular = match push {
+                    Push::ThroughCentres => T::zero(),
+                    Push::AtContacts => {
+                        let ac = <Const<D> as Space<T, D>>::cross(&ec.arm, nc);
+                        let ad = <Const<D> as Space<T, D>>::cross(&ed.arm, nd);
+                        <Const<D> as Space<T, D>>::angular_dot(
+                            &ac,
+                            &<Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, &ad),
+                        )
+                    }
+                };
+                // The linear term in `f64` too: rounded in `f32`, `n_c·n_d/m` of the
+                // light ball hid the heavy ball's part (see `Wide`).
+                let linear = wide(nc).dot(&wide(nd)) * part.inverse_mass.to_f64();
+                sum += (sc * sd).to_f64() * (linear + angular.to_f64());
+            }
+        }
+        sum
     }
 
     /// The ends of row `c` with their signs: `+1` for the end a push moves along `−n`.
@@ -271,6 +301,10 @@ pub(crate) struct Groups {
     last_hold: Vec<Option<f64>>,
     /// The balls with an entry in `last_hold`, to forget at the step's start.
     held: Vec<u32>,
+    /// Per ball: whether it is in a pile held at the step's start (see `piles`).
+    piled: Vec<bool>,
+    /// The balls marked in `piled`, to forget at the step's start.
+    piles: Vec<u32>,
 }
 
 /// A ball in no group.
@@ -284,6 +318,8 @@ impl Groups {
             balls: Vec::new(),
             last_hold: vec![None; n],
             held: Vec::new(),
+            piled: vec![false; n],
+            piles: Vec::new(),
         }
     }
 
@@ -299,6 +335,25 @@ impl Groups {
             self.last_hold[b as usize] = None;
         }
         self.held.clear();
+        for &b in &self.piles {
+            self.piled[b as usize] = false;
+        }
+        self.piles.clear();
+    }
+
+    /// Marks `balls` as a pile held at the step's start (see `piles`).
+    pub(crate) fn note_pile(&mut self, balls: &[usize]) {
+        for &b in balls {
+            if !self.piled[b] {
+                self.piled[b] = true;
+                self.piles.push(b as u32);
+            }
+        }
+    }
+
+    /// Whether ball `i` is in a pile held at the step's start (see `piles`).
+    pub(crate) fn piled(&self, i: usize) -> bool {
+        self.piled[i]
     }
 
     /// What the last hold of ball `i` in this step left: `None` if no hold took it in;
@@ -388,6 +443,37 @@ pub(crate) enum Approach {
     /// All that touch (and the slow ones closing within the step): the stack's balls
     /// are wedged (see `wedge`), and answering its contacts one at a time would not end.
     Any,
+    /// Those no faster than support (and those a collision with restitution below 1
+    /// strikes now), its free balls bringing in the free balls they touch or could
+    /// reach within the step: a pile held at the step's start
+    /// ([`Contacts::hold_resting`]) and again after a contact of one of its balls,
+    /// whose contacts answered one at a time would each hold the pile again.
+    Resting,
+}
+
+impl Approach {
+    /// How far beyond touching a contact is taken in, for a ball whose chord could close
+    /// a gap at `support_speed` over `rest`, the rest of the step: a pile's hold also
+    /// takes the gaps its balls could close within the step at twice the speed of
+    /// support (speculative contacts: a row whose gap stays open pushes nothing).
+    fn speculative<T: Real>(self, support_speed: T, rest: T) -> T {
+        match self {
+            Approach::Resting => T::lit(2.0) * support_speed * rest,
+            Approach::Slow | Approach::Any => T::zero(),
+        }
+    }
+
+    /// Whether a free ball a stack's cluster does not touch enters the stack, `touching`
+    /// or not: in a pile's hold, yes; in a wedge's, only touching (one closing within the
+    /// step is a collision of its own: a ball at 1e6 m/s closes on every ball it could
+    /// reach in the step); in others, no.
+    fn enters_free_ball(self, touching: bool) -> bool {
+        match self {
+            Approach::Slow => false,
+            Approach::Any => touching,
+            Approach::Resting => true,
+        }
+    }
 }
 
 /// Where a stack's impulses act on its bodies (see [`Stack::delassus`]).
@@ -397,6 +483,48 @@ enum Push {
     AtContacts,
     /// Through the centres of mass: force only (`Contacts::central`).
     ThroughCentres,
+}
+
+/// A stack's Delassus matrix: dense (solved exactly, `lcp`) or sparse (solved by
+/// projected conjugate gradients, `sparse_lcp`), by the stack's size.
+enum Delassus {
+    Dense(Vec<f64>),
+    Sparse(SparseMatrix),
+}
+
+/// The stacks' solvers and what they keep between holds.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Solvers<const D: usize> {
+    /// Scratch of the dense exact solves.
+    dense: Lcp,
+    /// Scratch of the sparse solves.
+    sparse: SparseLcp,
+    /// The impulses the sparse solves found, to start the next from.
+    pub(crate) warm: Warm<D>,
+}
+
+impl<const D: usize> Solvers<D> {
+    /// The most contacts of any problem solved so far.
+    pub(crate) fn largest(&self) -> usize {
+        self.dense.largest().max(self.sparse.largest())
+    }
+
+    /// Solves the contacts' problem with matrix `a` (see `lcp`); a sparse solve starts
+    /// from the impulses `lambda` holds, a dense one from none, or, `again` (the last
+    /// solve had the same matrix), from the last one's passive set.
+    fn solve(&mut self, a: &Delassus, q: &[f64], tolerance: f64, lambda: &mut [f64], again: bool) {
+        match a {
+            Delassus::Dense(a) if again => {
+                self.dense.resolve(a, q, tolerance, lambda);
+            }
+            Delassus::Dense(a) => {
+                self.dense.solve(a, q, tolerance, lambda);
+            }
+            Delassus::Sparse(a) => {
+                self.sparse.solve(a, q, tolerance, lambda);
+            }
+        }
+    }
 }
 
 /// Which velocities a phase acts on.
@@ -525,6 +653,29 @@ where
                 self.enter(&mut stack, self.side(ball), s);
             }
         }
+        self.hold_entered(stack, Some(&seed));
+    }
+
+    /// Holds the free balls `balls` at the step's start with every body they touch, and
+    /// what touches those (see [`Approach::Resting`]).
+    pub(crate) fn hold_resting(&mut self, balls: &[usize]) {
+        let mut stack = Stack {
+            s: T::zero(),
+            approach: Approach::Resting,
+            parts: Vec::new(),
+            rows: Vec::new(),
+        };
+        for &b in balls {
+            self.enter(&mut stack, self.side(b), T::zero());
+        }
+        self.hold_entered(stack, None);
+    }
+
+    /// Holds `stack`, its first bodies entered: finds their rows (entering the bodies
+    /// they bring in), then the impacts and the hold. `seed` is the contact the hold is
+    /// for, if any.
+    fn hold_entered(&mut self, mut stack: Stack<T, D>, seed: Option<&Seed<T, D>>) {
+        let s = stack.s;
         let mut k = 0;
         while k < stack.parts.len() {
             let balls: Vec<usize> = match stack.parts[k].side {
@@ -565,25 +716,55 @@ where
         let fast: Vec<bool> = (stack.rows.iter().zip(&start_approach).enumerate())
             .map(|(c, (row, &u))| {
                 let skip = match stack.approach {
-                    Approach::Slow => !seed.is(row),
+                    Approach::Slow | Approach::Resting => !seed.is_some_and(|seed| seed.is(row)),
                     Approach::Any => row.gap > tolerance(c),
                 };
                 skip && u > self.rules.support_speed
             })
             .collect();
-        // 1. Impacts: restitution 0 on the velocities at s, touching contacts only.
-        let touching: Vec<usize> = (0..stack.rows.len())
-            .filter(|&c| !fast[c] && stack.rows[c].gap <= tolerance(c))
+        // In a pile's hold, a collision that touches now with restitution below 1 is
+        // answered with the others at once (its margin `−e u`: it parts at `e` times its
+        // approach), so that a ball landing on a pile is passed down it in one hold, not
+        // in a collision per contact of the pile, each holding the pile again. Elastic
+        // ones stay events of their own: one at a time is the textbook answer (Newton's
+        // cradle), which simultaneous impulses are not.
+        let struck: Vec<bool> = (0..stack.rows.len())
+            .map(|c| {
+                stack.approach == Approach::Resting
+                    && fast[c]
+                    && stack.rows[c].gap <= tolerance(c)
+                    && self.row_restitution(&stack.rows[c]) < T::one()
+            })
             .collect();
-        let zero = vec![T::zero(); touching.len()];
-        let impacts = self.impulses(&stack, &touching, &start, &start_approach, &zero);
+        // 1. Impacts: restitution 0 on the velocities at s (the struck ones' own),
+        // touching contacts only.
+        let touching: Vec<usize> = (0..stack.rows.len())
+            .filter(|&c| (!fast[c] || struck[c]) && stack.rows[c].gap <= tolerance(c))
+            .collect();
+        let parting: Vec<T> = (touching.iter())
+            .map(|&c| {
+                if struck[c] {
+                    -self.row_restitution(&stack.rows[c]) * start_approach[c]
+                } else {
+                    T::zero()
+                }
+            })
+            .collect();
+        let impacts = self.impulses(
+            &stack,
+            &touching,
+            (&start, &start_approach, &parting),
+            false,
+        );
         let mut pushed = vec![false; stack.rows.len()];
         if impacts.iter().any(|p| *p != Wide::<D>::zeros()) {
             let changes = Self::changes(&stack, &touching, &impacts, &mut pushed);
             self.strike(&stack, &changes);
         }
         // 2. The hold: the chords, as a constant force over the rest of the step.
-        let held: Vec<usize> = (0..stack.rows.len()).filter(|&c| !fast[c]).collect();
+        let held: Vec<usize> = (0..stack.rows.len())
+            .filter(|&c| !fast[c] || struck[c])
+            .collect();
         self.save_free(&mut stack);
         let mut forced = vec![false; stack.rows.len()];
         self.hold(&mut stack, &held, s, &mut forced);
@@ -592,6 +773,15 @@ where
         }
         self.mark_held(&stack, &pushed);
         self.regroup(&stack, &forced);
+    }
+
+    /// The restitution of row `row`'s contact: the pair's, the border's or the box's.
+    fn row_restitution(&self, row: &Row<T, D>) -> T {
+        match row.target {
+            Target::Ball(j) => self.balls.pair_restitution(row.end.ball, j as usize),
+            Target::Border => self.rules.border_restitution,
+            Target::Box(k) => self.boxes.restitution[k as usize],
+        }
     }
 
     /// Phase 2 of [`Self::hold_stack`] on the rows `held`, rounds against the rotation's
@@ -937,7 +1127,7 @@ where
                 chords[c] -= moved;
                 approach[c] -= moved.dot(&stack.rows[c].normal);
             }
-            total = self.impulses(stack, held, &chords, &approach, targets);
+            total = self.impulses(stack, held, (&chords, &approach, targets), true);
             let changes = Self::changes(stack, held, &total, &mut unused);
             self.push(stack, &changes);
         }
@@ -977,8 +1167,8 @@ where
         let a = stack.delassus(held, Push::ThroughCentres);
         let q: Vec<f64> = excess.iter().map(|&u| -u.to_f64()).collect();
         let mut lambda = vec![0.0; held.len()];
-        self.lcp
-            .solve(&a, &q, self.tolerance(stack, held).to_f64(), &mut lambda);
+        let tolerance = self.tolerance(stack, held).to_f64();
+        self.solvers.solve(&a, &q, tolerance, &mut lambda, false);
         for (&c, &l) in held.iter().zip(&lambda) {
             if l <= 0.0 {
                 continue;
@@ -1136,12 +1326,11 @@ where
     /// bodies is added once, from the first).
     fn rows_of(&mut self, stack: &mut Stack<T, D>, k: usize, x: usize, s: T) {
         let rest = self.h - s;
-        let (p, r, chord) = {
-            let b = &*self.balls;
-            (b.position_at(x, s), b.radius[x], b.chord[x])
-        };
+        let b = &*self.balls;
+        let (p, r, chord) = (b.position_at(x, s), b.radius[x], b.chord[x]);
         let tolerance = touch_tolerance(&p, r);
-        let near = |gap: T, closing: T| gap <= tolerance || closing * rest > gap;
+        let reach = tolerance.max(stack.approach.speculative(self.rules.support_speed, rest));
+        let near = |gap: T, closing: T| gap <= reach || closing * rest > gap;
         // A wedge's hold takes a gap the time of impact cannot resolve for none.
         let (wedge_h, speed) = (stack.wedge_step(self.h), chord.norm());
         let centre = stack.parts[k].centre;
@@ -1224,11 +1413,8 @@ where
                     });
                     continue;
                 }
-                // A free ball enters only a wedge's hold, and only touching: one closing
-                // within the step is a collision of its own (a ball at 1e6 m/s closes on
-                // every ball it could reach in the step).
                 (None, Side::Ball(_))
-                    if !cluster_body && (stack.approach == Approach::Slow || gap > tolerance) =>
+                    if !cluster_body && !stack.approach.enters_free_ball(gap <= tolerance) =>
                 {
                     continue;
                 }
@@ -1268,6 +1454,61 @@ where
             && b.supported[j]
             && self.rules.lies_below((&p, b.radius[x]), (&y, b.radius[j]))
             && b.chord[j].dot(&n) >= -self.rules.floor * n.norm()
+    }
+
+    /// One Gauss–Seidel sweep of friction over `rows` (their velocities `relative`
+    /// before any impulse): each row's accumulated tangential impulse `tangential` stops
+    /// its slip under the normal impulses `lambda`, within `|F_t| <= μ λ`. Whether the
+    /// sweep changed no row's slip beyond rounding (1e-12 of the fastest).
+    fn friction_sweep(
+        &self,
+        stack: &Stack<T, D>,
+        rows: &[usize],
+        relative: &[Vector<T, D>],
+        lambda: &[f64],
+        tangential: &mut [Wide<D>],
+    ) -> bool {
+        let friction = self.rules.friction;
+        let mut change = T::zero();
+        let mut scale = T::zero();
+        let mut changes = Changes::new(stack.parts.len());
+        for (l, &d) in rows.iter().enumerate() {
+            let p = tangential[l] - wide(&stack.rows[d].normal) * lambda[l];
+            for (e, sign) in stack.ends(d) {
+                changes.add(&e, sign, &p);
+            }
+        }
+        for (k, &c) in rows.iter().enumerate() {
+            let row = &stack.rows[c];
+            let moved = stack.ends(c).fold(Vector::zeros(), |sum, (e, sign)| {
+                sum + changes.at(stack, &e) * sign
+            });
+            let u = relative[c] + moved;
+            let slip = u - row.normal * u.dot(&row.normal);
+            let speed = slip.norm();
+            scale = scale.max(relative[c].norm());
+            if speed <= T::zero() {
+                continue;
+            }
+            let t = slip / speed;
+            let k_t = stack.ends(c).fold(T::zero(), |sum, (e, _)| {
+                sum + stiffness(&stack.parts[e.part], &e, &t)
+            });
+            let wanted = tangential[k] - wide(&t) * (speed / k_t).to_f64();
+            let bound = friction.to_f64() * lambda[k];
+            let clamped = if wanted.norm() > bound {
+                wanted * (bound / wanted.norm())
+            } else {
+                wanted
+            };
+            let step = clamped - tangential[k];
+            tangential[k] = clamped;
+            for (e, sign) in stack.ends(c) {
+                changes.add(&e, sign, &step);
+            }
+            change = change.max(T::lit(step.norm()) * k_t);
+        }
+        change <= T::lit(1e-12) * scale
     }
 
     /// The velocity of the contact point at end `e` in `phase`.
@@ -1376,9 +1617,8 @@ where
         &mut self,
         stack: &Stack<T, D>,
         rows: &[usize],
-        relative: &[Vector<T, D>],
-        approach: &[T],
-        margins: &[T],
+        (relative, approach, margins): (&[Vector<T, D>], &[T], &[T]),
+        warm: bool,
     ) -> Vec<Wide<D>> {
         let n = rows.len();
         if n == 0 {
@@ -1390,8 +1630,21 @@ where
         let mut lambda = vec![0.0; n];
         let mut tangential = vec![Wide::<D>::zeros(); n];
         let friction = self.rules.friction;
-        for _ in 0..FRICTION_ROUNDS {
-            // Normal impulses against the approach the tangential ones leave.
+        let rest = (self.h - stack.s).to_f64();
+        let warm = warm && matches!(a, Delassus::Sparse(_)) && rest > 0.0;
+        if warm {
+            let rows = rows.iter().map(|&c| &stack.rows[c]);
+            (self.solvers.warm).start(
+                rows,
+                rest,
+                friction > T::zero(),
+                &mut lambda,
+                &mut tangential,
+            );
+        }
+        // The normal impulses against the approach the tangential ones leave.
+        let mut again = false;
+        let mut normal = |this: &mut Self, lambda: &mut [f64], tangential: &[Wide<D>]| {
             let mut changes = Changes::new(stack.parts.len());
             for (k, &c) in rows.iter().enumerate() {
                 for (e, sign) in stack.ends(c) {
@@ -1407,54 +1660,30 @@ where
                     (margins[k] - approach[k] - moved.dot(&row.normal)).to_f64()
                 })
                 .collect();
-            self.lcp.solve(&a, &q, tolerance, &mut lambda);
+            this.solvers.solve(&a, &q, tolerance, lambda, again);
+            again = true;
+        };
+        for _ in 0..FRICTION_ROUNDS {
+            normal(self, &mut lambda, &tangential);
             if friction <= T::zero() {
                 break;
             }
-            // Friction, one Gauss–Seidel sweep: the accumulated tangential impulse stops
-            // the slip, within |F_t| <= μ λ.
-            let mut change = T::zero();
-            let mut scale = T::zero();
-            let mut changes = Changes::new(stack.parts.len());
-            for (l, &d) in rows.iter().enumerate() {
-                let p = tangential[l] - wide(&stack.rows[d].normal) * lambda[l];
-                for (e, sign) in stack.ends(d) {
-                    changes.add(&e, sign, &p);
-                }
-            }
-            for (k, &c) in rows.iter().enumerate() {
-                let row = &stack.rows[c];
-                let moved = stack.ends(c).fold(Vector::zeros(), |sum, (e, sign)| {
-                    sum + changes.at(stack, &e) * sign
-                });
-                let u = relative[c] + moved;
-                let slip = u - row.normal * u.dot(&row.normal);
-                let speed = slip.norm();
-                scale = scale.max(relative[c].norm());
-                if speed <= T::zero() {
-                    continue;
-                }
-                let t = slip / speed;
-                let k_t = stack.ends(c).fold(T::zero(), |sum, (e, _)| {
-                    sum + stiffness(&stack.parts[e.part], &e, &t)
-                });
-                let wanted = tangential[k] - wide(&t) * (speed / k_t).to_f64();
-                let bound = friction.to_f64() * lambda[k];
-                let clamped = if wanted.norm() > bound {
-                    wanted * (bound / wanted.norm())
-                } else {
-                    wanted
-                };
-                let step = clamped - tangential[k];
-                tangential[k] = clamped;
-                for (e, sign) in stack.ends(c) {
-                    changes.add(&e, sign, &step);
-                }
-                change = change.max(T::lit(step.norm()) * k_t);
-            }
-            if change <= T::lit(1e-12) * scale {
+            if self.friction_sweep(stack, rows, relative, &lambda, &mut tangential) {
                 break;
             }
+        }
+        if let Delassus::Sparse(_) = a
+            && friction > T::zero()
+        {
+            // The last friction sweep moved the approaches: the normal impulses again, so
+            // that what the solve leaves closing is its tolerance, not the friction's
+            // last change (the sparse solve starts from the impulses it has, so this is
+            // a few steps).
+            normal(self, &mut lambda, &tangential);
+        }
+        if warm {
+            let rows = rows.iter().map(|&c| &stack.rows[c]);
+            self.solvers.warm.keep(rows, rest, &lambda, &tangential);
         }
         (rows.iter().zip(lambda.iter().zip(&tangential)))
             .map(|(&c, (&l, t))| t - wide(&stack.rows[c].normal) * l)

@@ -191,9 +191,24 @@ where
                 ball: i,
                 other: SeedOther::Ball(j),
             };
-            self.hold_stack(seed, s, Approach::Slow);
+            self.hold_stack(seed, s, self.rehold(i, Some(j)));
         }
         Ok(effect)
+    }
+
+    /// Which contacts a hold after a contact of ball `i` with `j` (or a surface, `None`)
+    /// takes in: one that touches a pile held at the step's start (see `piles`) takes in
+    /// every free ball near the stack ([`Approach::Resting`]), so that the pile is held
+    /// again at once, not grown by one ball a hold; any other only the slow contacts
+    /// ([`Approach::Slow`]).
+    fn rehold(&self, i: usize, j: Option<usize>) -> Approach {
+        let piled = |k: usize| self.balls.cluster[k] == FREE && self.groups.piled(k);
+        let free_j = j.is_none_or(|j| self.balls.cluster[j] == FREE);
+        if self.balls.cluster[i] == FREE && free_j && (piled(i) || j.is_some_and(piled)) {
+            Approach::Resting
+        } else {
+            Approach::Slow
+        }
     }
 
     /// Whether, of balls `i` at `xi` and `j` at `xj` (along `n` from `i` to `j`), the lower
@@ -258,7 +273,7 @@ where
                 ball: i,
                 other: SeedOther::Surface(*n),
             };
-            self.hold_stack(seed, s, Approach::Slow);
+            self.hold_stack(seed, s, self.rehold(i, None));
         }
         effect
     }

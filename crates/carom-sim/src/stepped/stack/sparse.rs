@@ -1,0 +1,137 @@
+//! A large stack's contacts as a sparse problem: its Delassus matrix by rows of non-zero
+//! entries (`sparse_lcp`), and the impulses its solves found, to start the next from.
+//!
+//! The dense exact solve of `lcp` costs `n²` memory and `n³` work for `n` rows: cheap for
+//! the few contacts of a cluster on a floor, hopeless for a pile (a hold of 480 balls
+//! has some 1,400 rows). A hold of more than [`SPARSE_ROWS`] rows builds only the entries
+//! of rows that share a body (a ball's half-dozen contacts each) and solves them by
+//! projected conjugate gradients (`sparse_lcp`), starting from the impulses the same
+//! rows took last ([`Warm`]): in a pile at rest one step's impulses are nearly the
+//! next's.
+
+use std::collections::HashMap;
+
+use carom_math::{Real, Space};
+use nalgebra::Const;
+
+use super::super::narrow::Target;
+use super::super::sparse_lcp::SparseMatrix;
+use super::{Push, Row, Stack, Wide};
+
+/// Holds of more rows than this solve their contacts' problems sparsely (see the module
+/// documentation); smaller ones exactly (`lcp`).
+pub(crate) const SPARSE_ROWS: usize = 256;
+
+/// A row's identity across holds and steps: its ball and what it touches (a ball, box
+/// `k`, or the wall along an axis and side, `2 axis + side`). A contact of two balls is
+/// keyed by the lower index first, whichever end the row has it at.
+type RowKey = (u32, u8, u32);
+
+/// The impulses sparse solves found, per row, as forces (the impulse over the rest of
+/// the step it acted over), to start the next solve of the same rows from. What one step
+/// found is kept for the next; rows not met again are forgotten.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Warm<const D: usize> {
+    /// Found in this step.
+    current: HashMap<RowKey, (f64, Wide<D>)>,
+    /// Found in the step before.
+    previous: HashMap<RowKey, (f64, Wide<D>)>,
+}
+
+impl<const D: usize> Warm<D> {
+    /// At the start of a step: what the last one found becomes the previous step's.
+    pub(crate) fn next_step(&mut self) {
+        core::mem::swap(&mut self.current, &mut self.previous);
+        self.current.clear();
+    }
+
+    /// Starts a solve of `rows` acting over `rest` from the impulses each took last (none
+    /// for a row not met before), tangential ones only `with_friction`.
+    pub(super) fn start<'a, T: Real + 'a>(
+        &self,
+        rows: impl Iterator<Item = &'a Row<T, D>>,
+        rest: f64,
+        with_friction: bool,
+        lambda: &mut [f64],
+        tangential: &mut [Wide<D>],
+    ) {
+        for ((l, t), row) in lambda.iter_mut().zip(tangential).zip(rows) {
+            let (key, sign) = row_key(row);
+            let last = self.current.get(&key).or_else(|| self.previous.get(&key));
+            (*l, *t) = last.map_or((0.0, Wide::zeros()), |&(l, t)| {
+                (l * rest, t * (rest * sign))
+            });
+            if !with_friction {
+                *t = Wide::zeros();
+            }
+        }
+    }
+
+    /// Keeps the impulses `lambda` and `tangential` that `rows` took acting over `rest`.
+    pub(super) fn keep<'a, T: Real + 'a>(
+        &mut self,
+        rows: impl Iterator<Item = &'a Row<T, D>>,
+        rest: f64,
+        lambda: &[f64],
+        tangential: &[Wide<D>],
+    ) {
+        for ((&l, t), row) in lambda.iter().zip(tangential).zip(rows) {
+            let (key, sign) = row_key(row);
+            self.current.insert(key, (l / rest, t * (sign / rest)));
+        }
+    }
+}
+
+/// Row `row`'s identity ([`RowKey`]), and the sign its tangential impulse takes there:
+/// `−1` where the key names the row's other ball first (the impulse on the row's ball is
+/// the opposite of the one on the key's).
+fn row_key<T: Real, const D: usize>(row: &Row<T, D>) -> (RowKey, f64) {
+    let ball = row.end.ball as u32;
+    match row.target {
+        Target::Ball(j) if j < ball => ((j, 0, ball), -1.0),
+        Target::Ball(j) => ((ball, 0, j), 1.0),
+        Target::Box(k) => ((ball, 1, k), 1.0),
+        Target::Border => {
+            let axis = (0..D).find(|&a| row.normal[a] != T::zero()).unwrap_or(0);
+            let side = 2 * axis as u32 + u32::from(row.normal[axis] > T::zero());
+            ((ball, 2, side), 1.0)
+        }
+    }
+}
+
+impl<T: Real, const D: usize> Stack<T, D>
+where
+    Const<D>: Space<T, D>,
+{
+    /// The Delassus matrix of `rows` ([`Stack::delassus`]'s entries) by rows of its
+    /// non-zero entries: only rows that share a body couple.
+    pub(super) fn sparse_delassus(&self, rows: &[usize], push: Push) -> SparseMatrix {
+        let mut by_part: Vec<Vec<usize>> = vec![Vec::new(); self.parts.len()];
+        for (k, &c) in rows.iter().enumerate() {
+            for (e, _) in self.ends(c) {
+                by_part[e.part].push(k);
+            }
+        }
+        let mut a = SparseMatrix::new();
+        let mut column = vec![usize::MAX; rows.len()];
+        let mut entries: Vec<(usize, f64)> = Vec::new();
+        for &c in rows {
+            entries.clear();
+            for (ec, _) in self.ends(c) {
+                for &l in &by_part[ec.part] {
+                    if column[l] == usize::MAX {
+                        column[l] = entries.len();
+                        entries.push((l, self.coupling(c, rows[l], push)));
+                    }
+                }
+            }
+            entries.sort_unstable_by_key(|&(l, _)| l);
+            for &(l, v) in &entries {
+                column[l] = usize::MAX;
+                a.push(l, v);
+            }
+            a.end_row();
+        }
+        a
+    }
+}
