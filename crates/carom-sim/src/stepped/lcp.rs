@@ -138,7 +138,9 @@ impl Lcp {
     /// matrix and a new `q`, starting from the last solution's passive set, its factor
     /// and impulses: the friction rounds of a hold change only `q`, and a passive set
     /// that still holds costs two triangular solves instead of a factorisation. The
-    /// result is the same solution (the margins are unique), to rounding.
+    /// result is the same solution (the margins are unique), to rounding, where it
+    /// returns `true`: with dependent contacts the walk back can end short of it (seen
+    /// in fuzzed scenes), and the caller then solves from scratch.
     pub(crate) fn resolve(
         &mut self,
         a: &[f64],

@@ -42,9 +42,10 @@
 //! beyond its margin, and leave none closing), whatever the mass ratios: a cluster a
 //! million times heavier than the one it rests on is held in one solve. With friction the
 //! normal impulses and the tangential ones (Coulomb's cone, projected Gauss–Seidel) are
-//! solved in turn until they agree (staggered projections); each round after the first
-//! solves again from the last one's passive set (`Lcp::resolve`: only the margins
-//! changed).
+//! solved in turn until they agree (staggered projections); in a pile's hold each round
+//! after the first solves again from the last one's passive set (`Lcp::resolve`: only the
+//! margins changed), falling back to a solve from scratch where that leaves a contact
+//! closing.
 //!
 //! **Piles.** Under gravity a pile of free balls (more than `piles::PILE_CONTACTS`
 //! resting contacts) is held whole at the step's start ([`Approach::Resting`]: its free
@@ -514,8 +515,12 @@ impl<const D: usize> Solvers<D> {
     /// solve had the same matrix), from the last one's passive set.
     fn solve(&mut self, a: &Delassus, q: &[f64], tolerance: f64, lambda: &mut [f64], again: bool) {
         match a {
+            // A solve again that leaves a margin closing (dependent contacts whose last
+            // passive set no longer fits) is solved from scratch, as it would have been.
             Delassus::Dense(a) if again => {
-                self.dense.resolve(a, q, tolerance, lambda);
+                if !self.dense.resolve(a, q, tolerance, lambda) {
+                    self.dense.solve(a, q, tolerance, lambda);
+                }
             }
             Delassus::Dense(a) => {
                 self.dense.solve(a, q, tolerance, lambda);
@@ -1661,7 +1666,9 @@ where
                 })
                 .collect();
             this.solvers.solve(&a, &q, tolerance, lambda, again);
-            again = true;
+            // A pile's friction rounds solve again from the last round's passive set;
+            // other holds from scratch (their numbers as before `resolve` existed).
+            again = stack.approach == Approach::Resting;
         };
         for _ in 0..FRICTION_ROUNDS {
             normal(self, &mut lambda, &tangential);
