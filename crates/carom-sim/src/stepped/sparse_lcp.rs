@@ -2,8 +2,9 @@
 //! contacts, by projected conjugate gradients.
 //!
 //! The problem is `lcp`'s (`w = A λ + q >= 0, λ >= 0, λ·w = 0`, `A` the contacts'
-//! Delassus matrix), for a stack too large for its dense exact solve: a pile of 480
-//! balls has some 1,400 contacts, whose dense matrix alone is 16 MB and whose
+//! Delassus matrix), for a stack too large for its dense exact solve: the settled pile
+//! of 480 balls (`docs/open-scenes`) is held in one hold of up to 1,025 contacts
+//! (`StepStats::largest_hold`), whose dense matrix alone is 8.4 MB and whose
 //! factorisations cost `n³`. Here `A` is stored by rows of its non-zero entries (two
 //! contacts couple only through a body they share: a ball's half-dozen contacts) and the
 //! problem is solved as the convex programme `min ½ λᵀAλ + qᵀλ` over `λ >= 0` by
@@ -23,8 +24,8 @@
 //!
 //! Conjugate gradients converge in about `√κ` steps where Gauss–Seidel takes `κ`
 //! sweeps (`κ` the condition number: about `k²` for a column of `k` balls), which is
-//! what makes a pile's tolerance reachable: projected Gauss–Seidel needed thousands of
-//! sweeps for a 64-ball pile and left its friction cycling. The problem is solved for
+//! what makes a pile's tolerance (a thousandth of the resting floor) reachable in a
+//! bounded number of steps. The problem is solved for
 //! `μ = D⁻¹ λ` with `D = diag(A)^(−1/2)` (a unit diagonal, as `lcp` does), which makes
 //! `ᾱ = 1/‖A‖` with `‖A‖` bounded by its largest absolute row sum (Gershgorin), and
 //! starts from the impulses given (a warm start: the last solve of the same contacts).
@@ -100,6 +101,8 @@ pub(crate) struct SparseLcp {
     direction: Vec<f64>,
     product: Vec<f64>,
     free: Vec<f64>,
+    /// The chopped gradient of a proportioning step.
+    chop: Vec<f64>,
     /// The largest problem solved so far (its number of contacts).
     largest: usize,
 }
@@ -134,12 +137,7 @@ impl SparseLcp {
         let dq: Vec<f64> = q.iter().zip(&self.scale).map(|(q, s)| q * s).collect();
         let limit: Vec<f64> = self.scale.iter().map(|s| tolerance * s).collect();
         let step = 1.0 / gershgorin(&self.scaled);
-        multiply(&self.scaled, &self.mu, &mut self.gradient);
-        for (g, d) in self.gradient.iter_mut().zip(&dq) {
-            *g += d;
-        }
-        self.free_gradient();
-        self.direction.clone_from(&self.free);
+        self.restart(&dq);
         let mut converged = false;
         for _ in 0..MAX_STEPS {
             if self.converged(&limit) {
@@ -191,21 +189,15 @@ impl SparseLcp {
                 }
             } else {
                 // Proportioning: along the chopped gradient, which only raises impulses.
-                let chop: Vec<f64> = (0..n)
-                    .map(|i| {
-                        if self.mu[i] <= 0.0 {
-                            self.gradient[i].min(0.0)
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect();
-                multiply(&self.scaled, &chop, &mut self.product);
-                let curvature = dot(&chop, &self.product);
+                for ((c, &g), &m) in self.chop.iter_mut().zip(&self.gradient).zip(&self.mu) {
+                    *c = if m <= 0.0 { g.min(0.0) } else { 0.0 };
+                }
+                multiply(&self.scaled, &self.chop, &mut self.product);
+                let curvature = dot(&self.chop, &self.product);
                 if curvature > 0.0 {
-                    let alpha = dot(&self.gradient, &chop) / curvature;
+                    let alpha = dot(&self.gradient, &self.chop) / curvature;
                     let moved = (self.mu.iter_mut().zip(&mut self.gradient))
-                        .zip(chop.iter().zip(&self.product));
+                        .zip(self.chop.iter().zip(&self.product));
                     for ((m, g), (c, p)) in moved {
                         *m -= alpha * c;
                         *g -= alpha * p;
@@ -238,6 +230,7 @@ impl SparseLcp {
             &mut self.direction,
             &mut self.product,
             &mut self.free,
+            &mut self.chop,
         ] {
             v.clear();
             v.resize(n, 0.0);
@@ -257,6 +250,12 @@ impl SparseLcp {
         for (m, &f) in self.mu.iter_mut().zip(&self.free) {
             *m = (*m - step * f).max(0.0);
         }
+        self.restart(dq);
+    }
+
+    /// The gradient `DAD μ + Dq` computed afresh from `μ` (`dq` the scaled `q`), and the
+    /// direction restarted along the free gradient.
+    fn restart(&mut self, dq: &[f64]) {
         multiply(&self.scaled, &self.mu, &mut self.gradient);
         for (g, d) in self.gradient.iter_mut().zip(dq) {
             *g += d;

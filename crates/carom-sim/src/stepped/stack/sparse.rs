@@ -2,8 +2,8 @@
 //! entries (`sparse_lcp`), and the impulses its solves found, to start the next from.
 //!
 //! The dense exact solve of `lcp` costs `n²` memory and `n³` work for `n` rows: cheap for
-//! the few contacts of a cluster on a floor, hopeless for a pile (a hold of 480 balls
-//! has some 1,400 rows). A hold of more than [`SPARSE_ROWS`] rows builds only the entries
+//! the few contacts of a cluster on a floor, hopeless for a pile (the settled 480-ball
+//! pile is one hold of up to 1,025 rows). A hold of more than [`SPARSE_ROWS`] rows builds only the entries
 //! of rows that share a body (a ball's half-dozen contacts each) and solves them by
 //! projected conjugate gradients (`sparse_lcp`), starting from the impulses the same
 //! rows took last ([`Warm`]): in a pile at rest one step's impulses are nearly the
