@@ -27,9 +27,11 @@ pub(crate) const SPARSE_ROWS: usize = 256;
 /// keyed by the lower index first, whichever end the row has it at.
 type RowKey = (u32, u8, u32);
 
-/// The impulses sparse solves found, per row, as forces (the impulse over the rest of
-/// the step it acted over), to start the next solve of the same rows from. What one step
-/// found is kept for the next; rows not met again are forgotten.
+/// The impulses sparse solves and a pile's dense ones found, per row, as forces (the
+/// impulse over the rest of the step it acted over), to start the next solve of the same
+/// rows from: the sparse solve from both, a dense one (exact in its normal impulses) from
+/// the tangential ones, whose rounds converge linearly. What one step found is kept for
+/// the next; rows not met again are forgotten.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Warm<const D: usize> {
     /// Found in this step.
