@@ -398,7 +398,7 @@ where
             p.push("response:friction".into());
         }
         let surfaces = self.border.is_some() || self.boxes.len() > 0;
-        if surfaces && self.rules.gravity != Vector::<T, D>::zeros() {
+        if surfaces && self.rules.has_gravity() {
             p.push("guard:resting".into());
         }
         if n >= 2 && self.balls.restitution.iter().any(|&e| e < T::one()) {
@@ -808,7 +808,7 @@ where
         let mut touches = core::mem::take(&mut self.touches);
         for (ball, out) in [i, other].into_iter().zip(touches.iter_mut()) {
             out.clear();
-            if self.rules.gravity != Vector::<T, D>::zeros() {
+            if self.rules.has_gravity() {
                 self.gather(ball, e.time, h, out);
             }
         }
@@ -923,7 +923,7 @@ where
     /// Holds every large pile at the step's start as one stack (see `piles`), under
     /// gravity: its contacts answered one at a time would each hold it again.
     fn hold_piles(&mut self, h: T, t0: T) {
-        if self.rules.gravity == Vector::<T, D>::zeros() {
+        if !self.rules.has_gravity() {
             return;
         }
         let piles = piles::resting_piles(

@@ -126,6 +126,11 @@ impl<T: Real, const D: usize> Rules<T, D> {
         })
     }
 
+    /// Whether the scene has gravity.
+    pub(crate) fn has_gravity(&self) -> bool {
+        self.gravity != Vector::<T, D>::zeros()
+    }
+
     /// How fast a contact may approach in a step of length `h` and be no contact: the
     /// narrow phase's events and the holds' aim (see [`Allowance`]).
     pub(crate) fn allowance(&self, h: T) -> Allowance<T, D> {

@@ -44,11 +44,12 @@
 //! normal impulses and the tangential ones (Coulomb's cone, projected Gauss–Seidel) are
 //! solved in turn until they agree (staggered projections), up to 32 rounds; under
 //! gravity, rounds that end with friction still moving end with the normal impulses once
-//! more, so that the hold leaves nothing closing. In a pile's hold each round after the first solves again
-//! from the last one's passive set (`Lcp::resolve`: only the margins changed), falling
-//! back to a solve from scratch where that leaves a contact closing, and the first
-//! starts from the forces the same contacts took in the last hold (`Warm`): friction
-//! converges linearly, slowly in a pile, and goes on converging from hold to hold.
+//! more, so that the hold leaves nothing closing. In a pile's hold each round after the
+//! first solves again from the last one's passive set (`Lcp::resolve`: only the margins
+//! changed), falling back to a solve from scratch where that leaves a contact closing,
+//! and the first starts from the forces the same contacts took in the last hold
+//! (`Warm`): friction converges linearly, slowly in a pile, and goes on converging from
+//! hold to hold.
 //!
 //! **Piles.** Under gravity a pile of free balls (more than `piles::PILE_CONTACTS`
 //! resting contacts) is held whole at the step's start ([`Approach::Resting`]: its free
@@ -1643,9 +1644,8 @@ where
         // last: friction's rounds converge linearly, and a pile held step after step
         // goes on converging from where the last hold left it instead of starting
         // from no friction each time (see `stack::Warm`).
-        let warm = warm
-            && (matches!(a, Delassus::Sparse(_)) || stack.approach == Approach::Resting)
-            && rest > 0.0;
+        let sparse = matches!(a, Delassus::Sparse(_));
+        let warm = warm && (sparse || stack.approach == Approach::Resting) && rest > 0.0;
         if warm {
             let rows = rows.iter().map(|&c| &stack.rows[c]);
             (self.solvers.warm).start(
@@ -1690,9 +1690,9 @@ where
                 break;
             }
         }
-        // Rounds that end with friction still moving (they converge linearly: in a
-        // 200-contact pile the sweep's change fell only from 0.2 to 0.017 of the fastest
-        // slip over 32 rounds) leave the last sweep's change in the approaches. Under
+        // Rounds that end with friction still moving (they converge linearly: in a pile's
+        // hold of over 200 contacts the sweep's change fell only from 0.2 to 0.017 of the
+        // fastest slip over 32 rounds) leave the last sweep's change in the approaches. Under
         // gravity the normal impulses are solved again, so that what the hold leaves
         // closing is the solve's tolerance, not friction's last change. Without this,
         // each round of a pile's `hold_rounds` found the same rows closing, solved the
@@ -1703,10 +1703,7 @@ where
         // kinematic-box squeezes into crush errors not yet told real or false
         // (`docs/stepped.md`). A sparse solve, a few steps from the impulses it has, is
         // solved again whenever there is friction.
-        let under_gravity = self.rules.gravity != Vector::<T, D>::zeros();
-        let resolve = (under_gravity && !settled)
-            || (matches!(a, Delassus::Sparse(_)) && friction > T::zero());
-        if resolve {
+        if (self.rules.has_gravity() && !settled) || (sparse && friction > T::zero()) {
             normal(self, &mut lambda, &tangential);
         }
         if warm {
