@@ -1136,7 +1136,16 @@ where
                 chords[c] -= moved;
                 approach[c] -= moved.dot(&stack.rows[c].normal);
             }
-            total = self.impulses(stack, held, (&chords, &approach, targets), true);
+            let last = core::mem::replace(
+                &mut total,
+                self.impulses(stack, held, (&chords, &approach, targets), true),
+            );
+            if total == last {
+                // The round solved what the last one did (rows left closing by what no
+                // round changes, such as friction's last sweep without gravity) and
+                // pushed to the same chords: every further round would too.
+                break;
+            }
             let changes = Self::changes(stack, held, &total, &mut unused);
             self.push(stack, &changes);
         }
