@@ -10,8 +10,8 @@
 //! starts and solves it directly ([`DirectSolve::solve`]), then amends the guess
 //! (`SparseLcp::guess_pushing`: the contacts an answer would pull with leave it, those
 //! still closing join it). Where a guess holds, its answer solves the problem within a
-//! thousandth of the solve's tolerance ([`PRECISE`]). Where the guesses do not settle, conjugate gradients take over from where
-//! the solve started.
+//! thousandth of the solve's tolerance ([`PRECISE`]). Where the guesses do not settle,
+//! conjugate gradients take over from where the solve started.
 //!
 //! A guess is solved by proximal rounds ([`PROXIMAL`]), which leave the impulses where
 //! they started along the directions the contacts' matrix does not move (a singular
@@ -19,13 +19,14 @@
 //!
 //! The factorisation is `nalgebra-sparse`'s Cholesky (`CscCholesky`), which follows the
 //! matrix's own order; the rows are put in reverse Cuthill–McKee order first (a
-//! breadth-first order of the contact graph, reversed), which keeps the factor within a
-//! band about as wide as one layer of the pile's contacts. A factorisation is kept while
-//! the matrix and the guess stay the same (a pile's friction rounds).
+//! breadth-first order of the contact graph, reversed, which confines the factor's
+//! fill-in to a band: a shuffled chain goes back to bandwidth 1, tested). A
+//! factorisation is kept while the matrix and the guess stay the same (a pile's
+//! friction rounds).
 
 use nalgebra::DMatrix;
+use nalgebra_sparse::CscMatrix;
 use nalgebra_sparse::factorization::CscCholesky;
-use nalgebra_sparse::{CscMatrix, SparseEntryMut};
 
 use super::SparseMatrix;
 
@@ -48,7 +49,8 @@ const PROXIMAL_ROUNDS: usize = 8;
 
 /// The rounds end once no margin of the guess's rows is beyond this fraction of its
 /// limit: a solve on the right guess is then exact beyond what conjugate gradients
-/// stop at, for a triangular solve more (the factorisation is the cost).
+/// stop at, for a round or two more, each a pair of triangular solves (the
+/// factorisation is kept).
 const PRECISE: f64 = 1e-3;
 
 /// A set of pushing contacts and its factorisation, for one matrix.
@@ -58,7 +60,7 @@ pub(super) struct DirectSolve {
     order: Vec<usize>,
     /// The rows of the factorisation kept, in that order (`F`).
     rows: Vec<usize>,
-    /// Their matrix `a_FF` and the factor of `a_FF + εI`, `None` when that could not be
+    /// Their shifted matrix `a_FF + εI` and its factor, `None` when that could not be
     /// factored.
     factor: Option<(CscMatrix<f64>, CscCholesky<f64>)>,
     /// Whether `rows` and `factor` are those of the current matrix.
@@ -89,9 +91,9 @@ impl DirectSolve {
 
     /// Solves `a_FF μ_F = −dq_F` for the rows `F` where `pushing` is set, with `μ` zero
     /// elsewhere, into `mu`, by proximal rounds from `start`'s impulses on `F` (see
-    /// [`PROXIMAL`]), until no row of `F` has a margin beyond [`PRECISE`] of its `limit`;
-    /// `a` is the
-    /// matrix of the last [`Self::new_matrix`], and at most [`PROXIMAL_ROUNDS`] rounds.
+    /// [`PROXIMAL`]), until no row of `F` has a margin beyond [`PRECISE`] of its `limit`,
+    /// at most [`PROXIMAL_ROUNDS`] rounds; `a` is the matrix of the last
+    /// [`Self::new_matrix`].
     /// Returns false, leaving `mu` as it was, when `a_FF + εI` cannot be factored (which
     /// rounding alone can cause) or a round's impulses are not finite.
     pub(super) fn solve(
@@ -108,7 +110,7 @@ impl DirectSolve {
         if !same {
             self.factor_rows(a, pushing);
         }
-        let Some((matrix, factor)) = &self.factor else {
+        let Some((shifted, factor)) = &self.factor else {
             return false;
         };
         let m = self.rows.len();
@@ -123,8 +125,11 @@ impl DirectSolve {
             if !x.iter().all(|v| v.is_finite()) {
                 return false;
             }
-            residual.fill(0.0);
-            for (k, column) in matrix.col_iter().enumerate() {
+            // a_FF x = (a_FF + εI) x − ε x.
+            for (g, &v) in residual.iter_mut().zip(x.iter()) {
+                *g = -PROXIMAL * v;
+            }
+            for (k, column) in shifted.col_iter().enumerate() {
                 for (&row, &v) in column.row_indices().iter().zip(column.values()) {
                     residual[row] += v * x[k];
                 }
@@ -154,17 +159,21 @@ impl DirectSolve {
             self.index[r] = k;
         }
         // `a` is symmetric: its rows restricted to F, in F's order, are the columns of
-        // a_FF in compressed-column form.
+        // a_FF in compressed-column form; ε goes on the diagonal as they are copied.
         let mut offsets = Vec::with_capacity(self.rows.len() + 1);
         let (mut indices, mut values) = (Vec::new(), Vec::new());
         let mut entries: Vec<(usize, f64)> = Vec::new();
         offsets.push(0);
         for &r in &self.rows {
             entries.clear();
+            let own = self.index[r];
             entries.extend(
                 a.row(r)
                     .filter(|&(c, _)| self.index[c] != usize::MAX)
-                    .map(|(c, v)| (self.index[c], v)),
+                    .map(|(c, v)| {
+                        let k = self.index[c];
+                        (k, if k == own { v + PROXIMAL } else { v })
+                    }),
             );
             entries.sort_unstable_by_key(|&(k, _)| k);
             indices.extend(entries.iter().map(|&(k, _)| k));
@@ -175,15 +184,9 @@ impl DirectSolve {
         self.kept = true;
         self.factor = CscMatrix::try_from_csc_data(m, m, offsets, indices, values)
             .ok()
-            .and_then(|matrix| {
-                let mut shifted = matrix.clone();
-                for k in 0..m {
-                    if let Some(SparseEntryMut::NonZero(v)) = shifted.get_entry_mut(k, k) {
-                        *v += PROXIMAL;
-                    }
-                }
+            .and_then(|shifted| {
                 let factor = CscCholesky::factor(&shifted).ok()?;
-                Some((matrix, factor))
+                Some((shifted, factor))
             });
     }
 }
