@@ -138,9 +138,10 @@ const FRICTION_ROUNDS: usize = 32;
 /// tangential impulses' power over the rows +19.3 where positive, −7.8 where
 /// negative), and 5 of its first 300 steps gained more than 1 mJ. With 128 none
 /// gained more than 4e-6 J (within what its narrow phase lets its weight do). A round
-/// there costs a triangular solve and a sweep (the factorisation is kept,
-/// `sparse_lcp`), so 128 cost 265 s for the pile's 300 steps against 116 s
-/// (`docs/stepped.md`).
+/// there costs a few triangular solves and a sweep (the factorisation is kept, and a
+/// guess near the factored one is solved on it, `sparse_lcp`): 128 cost 265 s for the
+/// pile's 300 steps against 116 s with 32 when each new guess was factored, 154–158 s
+/// since (`docs/stepped.md`).
 const SPARSE_FRICTION_ROUNDS: usize = 128;
 
 /// A body of a stack: a free ball or a cluster, restarted at the hold's instant.
