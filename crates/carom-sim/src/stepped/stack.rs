@@ -140,7 +140,7 @@ const FRICTION_ROUNDS: usize = 32;
 /// gained more than 4e-6 J (within what its narrow phase lets its weight do). A round
 /// there costs a few triangular solves and a sweep (the factorisation is kept, and a
 /// guess near the factored one is solved on it, `sparse_lcp`): 128 cost 265 s for the
-/// pile's 300 steps against 116 s with 32 when each new guess was factored, 154–158 s
+/// pile's 300 steps against 116 s with 32 when each new guess was factored, 154–164 s
 /// since (`docs/stepped.md`).
 const SPARSE_FRICTION_ROUNDS: usize = 128;
 
