@@ -60,8 +60,10 @@ const PRECISE: f64 = 1e-3;
 /// The most rows by which a guess may differ from the factored set (left out of it or
 /// added to it) and still be solved on that set's factor ([`Patch`]) instead of being
 /// factored afresh. Patching costs a pair of triangular solves per row it differs by,
-/// once, and a few small dense products per solve; a numeric factorisation of the
-/// 480-ball pile's sets cost about fifteen pairs (`docs/stepped.md`).
+/// once, and a few small dense products per solve; a factorisation of the 480-ball
+/// pile's sets cost about fifteen pairs in the rows' reverse Cuthill–McKee order (a
+/// profile) and about nineteen in their minimum degree order (timed on three of its
+/// matrices; `docs/stepped.md`).
 const MOST_PATCHED: usize = 8;
 
 /// A set of pushing contacts and the factorisation it is solved on, for one matrix.
