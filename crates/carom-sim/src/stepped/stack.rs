@@ -131,13 +131,14 @@ const HOLD_ROUNDS: usize = 8;
 const FRICTION_ROUNDS: usize = 32;
 
 /// Rounds of normal and tangential impulses in turn in a hold solved sparsely (above
-/// [`SPARSE_ROWS`] rows: a large pile's). Friction converges linearly, slowly in a
-/// pile, and rounds that end before it has converged leave it pushing along the slip
-/// on many rows once the last normal solve has moved the chords: with 32 rounds the
-/// 480-ball pile's one hold at the start of a step (980 rows) added 7.6 J (its
-/// tangential impulses' power over the rows +19.3 where positive, −7.8 where
-/// negative), and 5 of its first 300 steps gained more than 1 mJ. With 128 none
-/// gained more than 4e-6 J (within what its narrow phase lets its weight do). A round
+/// [`SPARSE_ROWS`] rows: a large pile's). Friction converges slowly in a pile (after
+/// 128 rounds a sweep still changes a median 9e-5 of the fastest slip), and rounds
+/// that end before it has converged leave it pushing along the slip on many rows once
+/// the last normal solve has moved the chords: with 32 rounds the 480-ball pile's one
+/// hold at the start of a step (980 rows) added 7.6 J (its tangential impulses' power
+/// over the rows +19.3 where positive, −7.8 where negative), and 5 of its first 300
+/// steps gained more than 1 mJ. With 128 no step of five runs of it gained 1 mJ (the
+/// largest rise 4e-6 J in one, 1.2e-4 J in another, 3.5e-9 of its energy). A round
 /// there costs a few triangular solves and a sweep (the factorisation is kept, and a
 /// guess near the factored one is solved on it, `sparse_lcp`): 128 cost 265 s for the
 /// pile's 300 steps against 116 s with 32 when each new guess was factored, 154–164 s

@@ -62,8 +62,8 @@ const PRECISE: f64 = 1e-3;
 /// factored afresh. Patching costs a pair of triangular solves per row it differs by,
 /// once, and a few small dense products per solve; a factorisation of the 480-ball
 /// pile's sets cost about fifteen pairs in the rows' reverse Cuthill–McKee order (a
-/// profile) and about nineteen in their minimum degree order (timed on three of its
-/// matrices; `docs/stepped.md`).
+/// profile) and 17–20 in their minimum degree order (timed on three of its matrices;
+/// `docs/stepped.md`).
 const MOST_PATCHED: usize = 8;
 
 /// A set of pushing contacts and the factorisation it is solved on, for one matrix.
