@@ -406,11 +406,14 @@ fn event_table(md: &mut String, report: &Report) {
         "How to read: ball–ball collisions per second of wall-clock time on one core, median \
          of several spans after the gas relaxed from its lattice start; the targets are the \
          event-driven engine issue's; EDMD (Smallenburg 2022, its published code) did \
-         {:.2}–{:.2} M/s in 3D at N = 32,000 on this project's VM (measured {}, see \
-         docs/event-engine.md). Energy drift over the whole run should be rounding only.\n",
+         {:.2}–{:.2} M/s in 3D at N = 32,000 on this project's VM (measured {}, carom \
+         {:.2} M/s in the same rounds; see docs/event-engine.md). That VM's speed changes \
+         from day to day by more than the two engines differ, so this report's rates are \
+         not a ratio to EDMD's. Energy drift over the whole run should be rounding only.\n",
         crate::targets::EDMD.0 / 1e6,
         crate::targets::EDMD.1 / 1e6,
         crate::targets::EDMD_MEASURED,
+        crate::targets::CAROM_BESIDE_EDMD / 1e6,
     );
     let _ = writeln!(
         md,
