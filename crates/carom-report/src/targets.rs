@@ -42,8 +42,9 @@ pub const EDMD_MEASURED: &str = "2026-11-25";
 /// carom's rate on the same scene in the same rounds as [`EDMD`] (the median of five,
 /// `event_throughput 32000 0.45 3 9 1`; docs/event-engine.md): the only ratio to EDMD
 /// measured side by side. This VM's speed changes from day to day by more than the
-/// engines differ (on 2026-11-29 the same build ran at a third to two fifths of its usual rate), so a
-/// report's own rate is set beside EDMD's with both dates and no ratio.
+/// engines differ (on 2026-11-29 the same build ran at a third to two fifths of its
+/// usual rate), so a report's own rate is set beside EDMD's with both dates and no
+/// ratio.
 pub const CAROM_BESIDE_EDMD: f64 = 0.781e6;
 /// A coherent broad-phase frame, nanoseconds per ball on one thread …
 pub const BROAD_COHERENT_NS: f64 = 40.0;
