@@ -27,6 +27,7 @@
 //! ```
 
 pub mod broad;
+pub mod ceiling;
 pub mod engines;
 mod error;
 pub mod font;
@@ -84,6 +85,8 @@ pub struct Config {
     pub broad_sampling: Sampling,
     /// Also measure Terdiman's 10,000 random boxes.
     pub random_boxes: bool,
+    /// The machine's 2-thread ceilings' loops (`ceiling`).
+    pub ceiling: ceiling::CeilingSizes,
 }
 
 impl Config {
@@ -109,6 +112,7 @@ impl Config {
                 budget: Duration::from_millis(150),
             },
             random_boxes: true,
+            ceiling: ceiling::CeilingSizes::report(),
         }
     }
 
@@ -166,6 +170,7 @@ impl Config {
                 budget: Duration::ZERO,
             },
             random_boxes: false,
+            ceiling: ceiling::CeilingSizes::tiny(),
             ..Self::quick()
         }
     }
@@ -289,9 +294,18 @@ fn peer_bvh_3d() -> Option<Box<dyn broad::Peer<3>>> {
 /// # Errors
 /// A case fails to build or run (a bug), or no thread pool can be made.
 pub fn measure(config: &Config, progress: &dyn Fn(Progress<'_>)) -> Result<Report, ReportError> {
+    let tasks = tasks(config);
+    progress(Progress {
+        done: 0,
+        total: tasks.len(),
+        message: "the machine's own 2-thread ceilings",
+    });
     let mut report = Report {
         mode: config.mode,
-        machine: Machine::detect(),
+        machine: Machine {
+            ceiling: Some(ceiling::measure(&config.ceiling)?),
+            ..Machine::detect()
+        },
         throughput: Vec::new(),
         work_precision: Vec::new(),
         stability: Vec::new(),
@@ -299,7 +313,6 @@ pub fn measure(config: &Config, progress: &dyn Fn(Progress<'_>)) -> Result<Repor
         scaling: Vec::new(),
     };
     let two = throughput::pool(2)?;
-    let tasks = tasks(config);
     for (done, &task) in tasks.iter().enumerate() {
         progress(Progress {
             done,

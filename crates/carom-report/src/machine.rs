@@ -21,6 +21,7 @@ impl Machine {
             load_average: std::fs::read_to_string("/proc/loadavg")
                 .ok()
                 .and_then(|text| text.split_whitespace().next()?.parse().ok()),
+            ceiling: None,
         }
     }
 

@@ -56,6 +56,23 @@ pub struct Machine {
     /// the other work competing for the CPUs.
     #[serde(default)]
     pub load_average: Option<f64>,
+    /// The machine's own 1 → 2 thread speedups on loops that share no data, measured in
+    /// the report's run (`ceiling`); `None` where not measured.
+    #[serde(default)]
+    pub ceiling: Option<Ceiling>,
+}
+
+/// The 1 → 2 thread speedups of three kinds of work on this machine, each of two equal
+/// tasks that share no data (see `ceiling`): what a parallel part doing that kind of
+/// work can reach at best.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ceiling {
+    /// Dependent floating-point operations in registers.
+    pub compute: f64,
+    /// Reading and rewriting a buffer larger than the cache, front to back.
+    pub streaming_memory: f64,
+    /// Reads at random places of a table larger than the cache.
+    pub random_reads: f64,
 }
 
 /// One engine on one scene at one size and thread count.

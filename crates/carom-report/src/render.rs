@@ -258,6 +258,16 @@ fn header(md: &mut String, report: &Report) {
          noisy, ratios measured in the same run less so. docs/benchmarks.md says how to \
          reproduce each figure. `report.json` holds every row."
     );
+    if let Some(c) = &m.ceiling {
+        let _ = writeln!(
+            md,
+            "\nThis machine's own 1 → 2 thread speedups, measured at the report's start on \
+             loops whose threads share no data: compute {:.2}×, streaming memory {:.2}×, \
+             random reads {:.2}×. A parallel part that waits on memory cannot scale beyond \
+             the memory figures (section 4).",
+            c.compute, c.streaming_memory, c.random_reads
+        );
+    }
     if m.busy() {
         let _ = writeln!(
             md,
@@ -491,6 +501,14 @@ fn scaling_table(md: &mut String, report: &Report, plots: &Plots) {
          largest size this report ran on both (the medians of section 3); 2× is ideal. The \
          event-driven engine runs on one core and has no row.\n"
     );
+    if let Some(c) = &report.machine.ceiling {
+        let _ = writeln!(
+            md,
+            "This machine's ceilings in the same run (loops whose threads share no data): \
+             compute {:.2}×, streaming memory {:.2}×, random reads {:.2}×.\n",
+            c.compute, c.streaming_memory, c.random_reads
+        );
+    }
     let _ = writeln!(
         md,
         "| part | N | 1 thread | 2 threads | speedup |\n|---|---|---|---|---|"

@@ -2,7 +2,8 @@
 //! the issue, and the summary and REPORT.md rendered from hand-built rows.
 
 use carom_report::model::{
-    BroadPhaseRow, Machine, Mode, Report, ScalingRow, StabilityRow, ThroughputRow, WorkPrecisionRow,
+    BroadPhaseRow, Ceiling, Machine, Mode, Report, ScalingRow, StabilityRow, ThroughputRow,
+    WorkPrecisionRow,
 };
 use carom_report::{Config, run_with, summary_table};
 use serde_json::Value;
@@ -43,6 +44,11 @@ fn a_tiny_report_writes_markdown_json_and_plots_that_parse_back() {
     }
     assert_eq!(json["mode"], "quick");
     assert!(json["machine"]["cpus"].as_u64().unwrap() >= 1);
+    // The machine's ceilings were measured first, and are ratios of times.
+    assert_eq!(messages[0], "the machine's own 2-thread ceilings");
+    let c = report.machine.ceiling.expect("measured in every report");
+    let ratios = [c.compute, c.streaming_memory, c.random_reads];
+    assert!(ratios.iter().all(|s| s.is_finite() && *s > 0.0), "{c:?}");
     let row = &json["throughput"][0];
     for key in [
         "scene",
@@ -148,6 +154,11 @@ fn hand_built() -> Report {
             optimized: true,
             unix_time: 1_700_000_000,
             load_average: Some(1.5),
+            ceiling: Some(Ceiling {
+                compute: 1.97,
+                streaming_memory: 1.72,
+                random_reads: 1.81,
+            }),
         },
         throughput: vec![
             stepped("carom-stepped", 10_000, 1, 2.0, 1e-15),
@@ -209,6 +220,16 @@ fn hand_built() -> Report {
             },
         ],
     }
+}
+
+#[test]
+fn a_report_json_from_before_the_ceilings_still_reads() {
+    let mut json = serde_json::to_value(hand_built()).unwrap();
+    let machine = json["machine"].as_object_mut().unwrap();
+    assert!(machine.remove("ceiling").is_some());
+    let old: Report = serde_json::from_value(json).unwrap();
+    assert_eq!(old.machine.ceiling, None);
+    assert_eq!(old.throughput, hand_built().throughput);
 }
 
 #[test]
@@ -290,6 +311,11 @@ fn the_markdown_lists_where_carom_is_worse_from_the_rows() {
     let md = carom_report::render::markdown(&report, &carom_report::render::Plots::default());
     assert!(md.contains("2023-11-14 22:13 UTC"));
     assert!(md.contains("**The machine was busy:** its load average was 1.5 on 2 CPUs"));
+    // The machine's own ceilings, in the header and beside the speedups of section 4.
+    let ceilings = "compute 1.97×, streaming memory 1.72×, random reads 1.81×";
+    assert_eq!(md.matches(ceilings).count(), 2, "{md}");
+    let scaling = &md[md.find("## 4. 2-core scaling").unwrap()..];
+    assert!(scaling.contains(ceilings), "{scaling}");
     assert!(md.contains("| speed 1e6 m/s | **FAIL** | tunnelled |"));
     assert!(
         md.contains("| 10,000 | 1 | 2.00 ms | 12.0 ms | 6.0× | +1.0e-15 | -1.9e-1 |"),

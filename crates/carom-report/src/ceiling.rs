@@ -1,0 +1,208 @@
+//! The machine's own 2-thread ceilings: the 1 → 2 thread speedups of three loops that
+//! share no data between their threads, measured in the report's run beside the parts
+//! of section 4.
+//!
+//! A parallel part of an engine cannot scale better than the machine lets the kind of
+//! work it does scale. On this project's 2-core VM a loop of dependent floating-point
+//! operations scales by 1.95–2.00× while a loop streaming through memory scales by
+//! 1.65–1.79× (2026-11-29), and how far the cores share their memory bandwidth changes
+//! from day to day. Each loop here runs as two equal tasks, one after the other on a
+//! pool of one thread and at once on a pool of two, in alternating rounds; the ceiling is
+//! the median of the rounds' time ratios:
+//!
+//! * **compute**: a chain of square roots in registers, no memory traffic;
+//! * **streaming memory**: each task reads and rewrites its own buffer, larger than the
+//!   last-level cache, front to back;
+//! * **random reads**: each task sums entries of its own table, larger than the cache,
+//!   at indices from a linear congruential sequence that does not depend on what it
+//!   reads (so the core can keep several misses in flight, as the engines' read-ahead
+//!   does).
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use crate::error::ReportError;
+use crate::model::Ceiling;
+use crate::throughput::pool;
+
+/// How much work each ceiling's loops do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CeilingSizes {
+    /// Square roots per compute task.
+    pub compute_steps: usize,
+    /// `f64` entries of each task's streaming buffer and random-read table.
+    pub buffer_len: usize,
+    /// Reads per random-read task.
+    pub random_reads: usize,
+    /// Rounds of 1 and 2 threads; the median ratio is kept.
+    pub rounds: usize,
+}
+
+impl CeilingSizes {
+    /// About a second and a half on this project's VM: buffers of 32 MiB (4 times its
+    /// last-level cache).
+    pub fn report() -> Self {
+        Self {
+            compute_steps: 4_000_000,
+            buffer_len: 4 << 20,
+            random_reads: 4_000_000,
+            rounds: 5,
+        }
+    }
+
+    /// Milliseconds, for tests of the machinery (figures meaningless).
+    pub fn tiny() -> Self {
+        Self {
+            compute_steps: 10_000,
+            buffer_len: 10_000,
+            random_reads: 10_000,
+            rounds: 1,
+        }
+    }
+}
+
+/// Measures the three ceilings (see the [module documentation](self)).
+///
+/// # Errors
+/// A thread pool that cannot be built.
+pub fn measure(sizes: &CeilingSizes) -> Result<Ceiling, ReportError> {
+    let one = pool(1)?;
+    let two = pool(2)?;
+    let mut buffers = [
+        vec![1.0_f64; sizes.buffer_len],
+        vec![1.0_f64; sizes.buffer_len],
+    ];
+    let compute = speedup(&one, &two, sizes.rounds, |task| {
+        black_box(square_roots(task as f64, sizes.compute_steps));
+    });
+    let streaming = speedup_mut(&one, &two, sizes.rounds, &mut buffers, |buffer| {
+        black_box(stream(buffer));
+    });
+    let random = speedup_mut(&one, &two, sizes.rounds, &mut buffers, |table| {
+        black_box(random_sum(table, sizes.random_reads));
+    });
+    Ok(Ceiling {
+        compute,
+        streaming_memory: streaming,
+        random_reads: random,
+    })
+}
+
+/// The median over `rounds` of (time of tasks 0 and 1 on `one`) / (time on `two`).
+fn speedup(
+    one: &rayon::ThreadPool,
+    two: &rayon::ThreadPool,
+    rounds: usize,
+    task: impl Fn(usize) + Sync,
+) -> f64 {
+    let timed = |pool: &rayon::ThreadPool| {
+        let start = Instant::now();
+        pool.install(|| rayon::join(|| task(0), || task(1)));
+        start.elapsed().as_secs_f64()
+    };
+    median(
+        (0..rounds.max(1))
+            .map(|_| timed(one) / timed(two))
+            .collect(),
+    )
+}
+
+/// [`speedup`] of a task on each of two buffers of its own.
+fn speedup_mut(
+    one: &rayon::ThreadPool,
+    two: &rayon::ThreadPool,
+    rounds: usize,
+    buffers: &mut [Vec<f64>; 2],
+    task: impl Fn(&mut [f64]) + Sync,
+) -> f64 {
+    let mut timed = |pool: &rayon::ThreadPool| {
+        let [a, b] = buffers;
+        let start = Instant::now();
+        pool.install(|| rayon::join(|| task(a), || task(b)));
+        start.elapsed().as_secs_f64()
+    };
+    let mut ratios = Vec::with_capacity(rounds.max(1));
+    for _ in 0..rounds.max(1) {
+        let t1 = timed(one);
+        ratios.push(t1 / timed(two));
+    }
+    median(ratios)
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() / 2]
+}
+
+/// `steps` dependent square roots from `seed`.
+fn square_roots(seed: f64, steps: usize) -> f64 {
+    let mut x = seed + 2.0;
+    let mut sum = 0.0;
+    for _ in 0..steps {
+        x = (x * 1.000_001 + 0.5).sqrt();
+        sum += x;
+    }
+    sum
+}
+
+/// Reads and rewrites `buffer` front to back, twice.
+fn stream(buffer: &mut [f64]) -> f64 {
+    let mut sum = 0.0;
+    for _ in 0..2 {
+        for v in buffer.iter_mut() {
+            *v = *v * 0.999_999 + 1e-6;
+            sum += *v;
+        }
+    }
+    sum
+}
+
+/// The sum of `reads` entries of `table` at indices of a linear congruential sequence
+/// (Knuth's MMIX constants; the high bits index the table).
+fn random_sum(table: &[f64], reads: usize) -> f64 {
+    let len = table.len() as u64;
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut sum = 0.0;
+    for _ in 0..reads {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        sum += table[((state >> 32) % len) as usize];
+    }
+    sum
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_loops_compute_what_they_say() {
+        // A square root chain from x: x ← sqrt(1.000001 x + 0.5), summed.
+        let mut x = 2.0_f64;
+        let mut sum = 0.0;
+        for _ in 0..3 {
+            x = (x * 1.000_001 + 0.5).sqrt();
+            sum += x;
+        }
+        assert_eq!(square_roots(0.0, 3), sum);
+        // Streaming twice over ones: each pass maps v to 0.999999 v + 1e-6, which keeps 1.
+        let mut buffer = vec![1.0; 10];
+        let s = stream(&mut buffer);
+        assert!((s - 20.0).abs() < 1e-9, "{s}");
+        // Random reads of a table of ones sum to the number of reads.
+        assert_eq!(random_sum(&[1.0; 1000], 777), 777.0);
+    }
+
+    #[test]
+    fn tiny_ceilings_are_positive_ratios() {
+        let c = measure(&CeilingSizes::tiny()).expect("pools of 1 and 2 threads");
+        for (name, s) in [
+            ("compute", c.compute),
+            ("streaming", c.streaming_memory),
+            ("random", c.random_reads),
+        ] {
+            assert!(s.is_finite() && s > 0.0, "{name}: {s}");
+        }
+    }
+}
