@@ -15,7 +15,9 @@
 //! * `CAROM_BENCH_TABLE=1 cargo bench --bench stepped`: prints the markdown table of
 //!   docs/stepped.md instead: median milliseconds per step of both engines on 1 and 2
 //!   threads, the ratio, the 2-thread speedups, and the relative energy drift of each
-//!   over 5 s of simulated time (`CAROM_BENCH_SIZES=1000,10000,100000` to choose N).
+//!   over 5 s of simulated time (`CAROM_BENCH_SIZES=1000,10000,100000` to choose N),
+//!   after the machine's own 2-thread speedups on loops that share no data
+//!   (`carom_report::ceiling`), the ceilings the speedups are to be read against.
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -164,6 +166,12 @@ fn ms(d: Duration) -> f64 {
 fn print_table() {
     let (one, two) = (pool(1), pool(2));
     println!("{}", rapier_scene(&scene(10)).settings());
+    let c = carom_report::ceiling::measure(&carom_report::ceiling::CeilingSizes::report())
+        .expect("pools of 1 and 2 threads");
+    println!(
+        "this machine's own 2-thread speedups now (docs/benchmarks.md): compute {:.2}×, streaming memory {:.2}×, random reads {:.2}×",
+        c.compute, c.streaming_memory, c.random_reads
+    );
     println!(
         "| N | carom 1t (ms/step) | carom 2t | rapier2d 1t | rapier2d 2t | rapier2d / carom (1t) | carom 2t speedup | rapier2d 2t speedup | energy drift 5 s: carom | rapier2d |"
     );
