@@ -1,6 +1,6 @@
-//! The machine's own 2-thread ceilings: the 1 → 2 thread speedups of three loops that
-//! share no data between their threads, measured in the report's run beside the parts
-//! of section 4.
+//! The machine's own 2-thread ceilings and one-core speeds: the 1 → 2 thread speedups
+//! of three loops that share no data between their threads, measured in the report's
+//! run beside the parts of section 4.
 //!
 //! A parallel part of an engine cannot scale better than the machine lets the kind of
 //! work it does scale. On this project's 2-core VM a loop of dependent floating-point
@@ -17,6 +17,10 @@
 //!   at indices from a linear congruential sequence that does not depend on what it
 //!   reads (so the core can keep several misses in flight, as the engines' read-ahead
 //!   does).
+//!
+//! The same runs give what one core does of each loop (square roots, bytes streamed and
+//! random reads per second): a machine's speed on the day, to compare before comparing
+//! two reports' timings (this VM's changes by a factor of up to three).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -61,72 +65,67 @@ impl CeilingSizes {
     }
 }
 
-/// Measures the three ceilings (see the [module documentation](self)).
+/// Measures the three ceilings (see the [module documentation](self)), and what one
+/// core does of each loop.
 ///
 /// # Errors
 /// A thread pool that cannot be built.
 pub fn measure(sizes: &CeilingSizes) -> Result<Ceiling, ReportError> {
     let one = pool(1)?;
     let two = pool(2)?;
+    let rounds = sizes.rounds;
     let mut buffers = [
         vec![1.0_f64; sizes.buffer_len],
         vec![1.0_f64; sizes.buffer_len],
     ];
-    let compute = speedup(&one, &two, sizes.rounds, |task| {
-        black_box(square_roots(task as f64, sizes.compute_steps));
+    let steps = sizes.compute_steps;
+    let (compute_1t, compute) = alternate(&one, &two, rounds, |p| {
+        black_box(
+            p.install(|| rayon::join(|| square_roots(0.0, steps), || square_roots(1.0, steps))),
+        );
     });
-    let streaming = speedup_mut(&one, &two, sizes.rounds, &mut buffers, |buffer| {
-        black_box(stream(buffer));
+    let (stream_1t, streaming_memory) = alternate(&one, &two, rounds, |p| {
+        let [a, b] = &mut buffers;
+        black_box(p.install(|| rayon::join(|| stream(a), || stream(b))));
     });
-    let random = speedup_mut(&one, &two, sizes.rounds, &mut buffers, |table| {
-        black_box(random_sum(table, sizes.random_reads));
+    let reads = sizes.random_reads;
+    let (random_1t, random_reads) = alternate(&one, &two, rounds, |p| {
+        let [a, b] = &buffers;
+        black_box(p.install(|| rayon::join(|| random_sum(a, reads), || random_sum(b, reads))));
     });
+    // Both tasks on one thread: twice each loop's work. A streaming pass reads and writes
+    // each entry (16 bytes moved per `f64`), twice per task.
+    let streamed = (2 * STREAM_PASSES * 16 * sizes.buffer_len) as f64;
     Ok(Ceiling {
         compute,
-        streaming_memory: streaming,
-        random_reads: random,
+        streaming_memory,
+        random_reads,
+        one_core_square_roots_per_s: (2 * steps) as f64 / compute_1t,
+        one_core_stream_bytes_per_s: streamed / stream_1t,
+        one_core_random_reads_per_s: (2 * reads) as f64 / random_1t,
     })
 }
 
-/// The median over `rounds` of (time of tasks 0 and 1 on `one`) / (time on `two`).
-fn speedup(
+/// Runs `run` on `one` and on `two` in turn for `rounds` rounds: the median seconds on
+/// `one`, and the median of the rounds' ratios (seconds on `one` over seconds on `two`).
+fn alternate(
     one: &rayon::ThreadPool,
     two: &rayon::ThreadPool,
     rounds: usize,
-    task: impl Fn(usize) + Sync,
-) -> f64 {
-    let timed = |pool: &rayon::ThreadPool| {
-        let start = Instant::now();
-        pool.install(|| rayon::join(|| task(0), || task(1)));
-        start.elapsed().as_secs_f64()
-    };
-    median(
-        (0..rounds.max(1))
-            .map(|_| timed(one) / timed(two))
-            .collect(),
-    )
-}
-
-/// [`speedup`] of a task on each of two buffers of its own.
-fn speedup_mut(
-    one: &rayon::ThreadPool,
-    two: &rayon::ThreadPool,
-    rounds: usize,
-    buffers: &mut [Vec<f64>; 2],
-    task: impl Fn(&mut [f64]) + Sync,
-) -> f64 {
+    mut run: impl FnMut(&rayon::ThreadPool),
+) -> (f64, f64) {
     let mut timed = |pool: &rayon::ThreadPool| {
-        let [a, b] = buffers;
         let start = Instant::now();
-        pool.install(|| rayon::join(|| task(a), || task(b)));
+        run(pool);
         start.elapsed().as_secs_f64()
     };
-    let mut ratios = Vec::with_capacity(rounds.max(1));
+    let (mut seconds, mut ratios) = (Vec::new(), Vec::new());
     for _ in 0..rounds.max(1) {
         let t1 = timed(one);
+        seconds.push(t1);
         ratios.push(t1 / timed(two));
     }
-    median(ratios)
+    (median(seconds), median(ratios))
 }
 
 fn median(mut values: Vec<f64>) -> f64 {
@@ -145,10 +144,13 @@ fn square_roots(seed: f64, steps: usize) -> f64 {
     sum
 }
 
-/// Reads and rewrites `buffer` front to back, twice.
+/// Passes of [`stream`] over its buffer.
+const STREAM_PASSES: usize = 2;
+
+/// Reads and rewrites `buffer` front to back, [`STREAM_PASSES`] times.
 fn stream(buffer: &mut [f64]) -> f64 {
     let mut sum = 0.0;
-    for _ in 0..2 {
+    for _ in 0..STREAM_PASSES {
         for v in buffer.iter_mut() {
             *v = *v * 0.999_999 + 1e-6;
             sum += *v;
@@ -201,6 +203,9 @@ mod tests {
             ("compute", c.compute),
             ("streaming", c.streaming_memory),
             ("random", c.random_reads),
+            ("square roots", c.one_core_square_roots_per_s),
+            ("stream bytes", c.one_core_stream_bytes_per_s),
+            ("random reads", c.one_core_random_reads_per_s),
         ] {
             assert!(s.is_finite() && s > 0.0, "{name}: {s}");
         }

@@ -64,7 +64,7 @@ pub struct Machine {
 
 /// The 1 → 2 thread speedups of three kinds of work on this machine, each of two equal
 /// tasks that share no data (see `ceiling`): what a parallel part doing that kind of
-/// work can reach at best.
+/// work can reach at best; and the rates of one core on each.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Ceiling {
     /// Dependent floating-point operations in registers.
@@ -73,6 +73,13 @@ pub struct Ceiling {
     pub streaming_memory: f64,
     /// Reads at random places of a table larger than the cache.
     pub random_reads: f64,
+    /// What one core did of each loop, to compare machines (or one VM on two days)
+    /// before comparing reports' timings: square roots per second, …
+    pub one_core_square_roots_per_s: f64,
+    /// … bytes read and written per second streaming, …
+    pub one_core_stream_bytes_per_s: f64,
+    /// … and random reads per second.
+    pub one_core_random_reads_per_s: f64,
 }
 
 /// One engine on one scene at one size and thread count.

@@ -158,6 +158,9 @@ fn hand_built() -> Report {
                 compute: 1.97,
                 streaming_memory: 1.72,
                 random_reads: 1.81,
+                one_core_square_roots_per_s: 1.5e8,
+                one_core_stream_bytes_per_s: 1.23e10,
+                one_core_random_reads_per_s: 4.4e7,
             }),
         },
         throughput: vec![
@@ -314,6 +317,10 @@ fn the_markdown_lists_where_carom_is_worse_from_the_rows() {
     // The machine's own ceilings, in the header and beside the speedups of section 4.
     let ceilings = "compute 1.97×, streaming memory 1.72×, random reads 1.81×";
     assert_eq!(md.matches(ceilings).count(), 2, "{md}");
+    assert!(
+        md.contains("did 150 M square roots/s, streamed 12.3 GB/s and made 44 M random reads/s"),
+        "{md}"
+    );
     let scaling = &md[md.find("## 4. 2-core scaling").unwrap()..];
     assert!(scaling.contains(ceilings), "{scaling}");
     assert!(md.contains("| speed 1e6 m/s | **FAIL** | tunnelled |"));
