@@ -3,10 +3,11 @@
 //! run beside the parts of section 4.
 //!
 //! A parallel part of an engine cannot scale better than the machine lets the kind of
-//! work it does scale. On this project's 2-core VM a loop of dependent floating-point
-//! operations scales by 1.95–2.00× while a loop streaming through memory scales by
-//! 1.65–1.79× (2026-11-29), and how far the cores share their memory bandwidth changes
-//! from day to day. Each loop here runs as two equal tasks, one after the other on a
+//! work it does scale. On this project's 2-core VM, in twelve runs of [`measure`] on
+//! 2026-11-29 (in reports, the stepped bench's table and alone), the compute loop scaled
+//! by 1.84–2.00× and the streaming loop by 1.44–1.73×; the random reads, the noisiest,
+//! by 1.80–2.01× in nine of them and 0.78–1.39× in three run right after a build, while
+//! the machine's load average was still above 1. Each loop here runs as two equal tasks, one after the other on a
 //! pool of one thread and at once on a pool of two, in alternating rounds; the ceiling is
 //! the median of the rounds' time ratios:
 //!
@@ -23,11 +24,11 @@
 //! two reports' timings (this VM's changes by a factor of up to three).
 
 use std::hint::black_box;
-use std::time::Instant;
 
 use crate::error::ReportError;
 use crate::model::Ceiling;
 use crate::throughput::pool;
+use crate::timing::{median, timed};
 
 /// How much work each ceiling's loops do.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,7 +44,7 @@ pub struct CeilingSizes {
 }
 
 impl CeilingSizes {
-    /// About a second and a half on this project's VM: buffers of 32 MiB (4 times its
+    /// 2.5–3.2 s on this project's VM (2026-11-29): buffers of 32 MiB (4 times its
     /// last-level cache).
     pub fn report() -> Self {
         Self {
@@ -62,6 +63,17 @@ impl CeilingSizes {
             random_reads: 10_000,
             rounds: 1,
         }
+    }
+}
+
+impl Ceiling {
+    /// The three speedups as the report and the stepped bench print them: `compute
+    /// 1.97×, streaming memory 1.72×, random reads 1.81×`.
+    pub fn speedups(&self) -> String {
+        format!(
+            "compute {:.2}×, streaming memory {:.2}×, random reads {:.2}×",
+            self.compute, self.streaming_memory, self.random_reads
+        )
     }
 }
 
@@ -114,23 +126,13 @@ fn alternate(
     rounds: usize,
     mut run: impl FnMut(&rayon::ThreadPool),
 ) -> (f64, f64) {
-    let mut timed = |pool: &rayon::ThreadPool| {
-        let start = Instant::now();
-        run(pool);
-        start.elapsed().as_secs_f64()
-    };
     let (mut seconds, mut ratios) = (Vec::new(), Vec::new());
     for _ in 0..rounds.max(1) {
-        let t1 = timed(one);
+        let t1 = timed(|| run(one)).1.as_secs_f64();
         seconds.push(t1);
-        ratios.push(t1 / timed(two));
+        ratios.push(t1 / timed(|| run(two)).1.as_secs_f64());
     }
-    (median(seconds), median(ratios))
-}
-
-fn median(mut values: Vec<f64>) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
+    (median(&mut seconds), median(&mut ratios))
 }
 
 /// `steps` dependent square roots from `seed`.

@@ -262,14 +262,11 @@ fn header(md: &mut String, report: &Report) {
         let _ = writeln!(
             md,
             "\nThis machine's own 1 → 2 thread speedups, measured at the report's start on \
-             loops whose threads share no data: compute {:.2}×, streaming memory {:.2}×, \
-             random reads {:.2}×. A parallel part that waits on memory cannot scale beyond \
-             the memory figures (section 4). One core of it did {:.0} M square roots/s, \
-             streamed {:.1} GB/s and made {:.0} M random reads/s: compare these before \
-             comparing two reports' timings.",
-            c.compute,
-            c.streaming_memory,
-            c.random_reads,
+             loops whose threads share no data: {}. A parallel part that waits on memory \
+             cannot scale beyond the memory figures (section 4). One core of it did {:.0} M \
+             square roots/s, streamed {:.1} GB/s and made {:.0} M random reads/s: compare \
+             these before comparing two reports' timings.",
+            c.speedups(),
             c.one_core_square_roots_per_s / 1e6,
             c.one_core_stream_bytes_per_s / 1e9,
             c.one_core_random_reads_per_s / 1e6,
@@ -512,8 +509,8 @@ fn scaling_table(md: &mut String, report: &Report, plots: &Plots) {
         let _ = writeln!(
             md,
             "This machine's ceilings in the same run (loops whose threads share no data): \
-             compute {:.2}×, streaming memory {:.2}×, random reads {:.2}×.\n",
-            c.compute, c.streaming_memory, c.random_reads
+             {}.\n",
+            c.speedups()
         );
     }
     let _ = writeln!(

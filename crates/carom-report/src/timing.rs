@@ -23,12 +23,13 @@ const MAX_SAMPLES: usize = 200;
 /// The shortest sample: batches of calls last at least this long.
 const MIN_SAMPLE: Duration = Duration::from_millis(5);
 
-/// The median of `samples` (the upper median for an even count); zero when empty.
-pub fn median(samples: &mut [Duration]) -> Duration {
+/// The median of `samples` (the upper median for an even count); zero (the default)
+/// when empty. Durations, or ratios of them (`f64`; no sample may be NaN).
+pub fn median<T: Copy + Default + PartialOrd>(samples: &mut [T]) -> T {
     if samples.is_empty() {
-        return Duration::ZERO;
+        return T::default();
     }
-    samples.sort_unstable();
+    samples.sort_unstable_by(|a, b| a.partial_cmp(b).unwrap_or(core::cmp::Ordering::Equal));
     samples[samples.len() / 2]
 }
 
@@ -72,7 +73,8 @@ mod tests {
         let ms = Duration::from_millis;
         assert_eq!(median(&mut [ms(5), ms(1), ms(9)]), ms(5));
         assert_eq!(median(&mut [ms(4), ms(1), ms(9), ms(2)]), ms(4));
-        assert_eq!(median(&mut []), Duration::ZERO);
+        assert_eq!(median::<Duration>(&mut []), Duration::ZERO);
+        assert_eq!(median(&mut [1.5, 0.5, 2.5, 1.0]), 1.5);
     }
 
     #[test]
