@@ -16,14 +16,14 @@
     reason = "the example's `main` is not called: the tests call `run`"
 )]
 #[path = "../examples/collision_lab/main.rs"]
-mod collision_lab;
+mod example;
 
-use collision_lab::{Outcome, run};
+use example::{Outcome, run};
 
 use carom::sim::Collision;
 use carom::sim::scenes::collision_lab::play_area;
 
-use collision_lab::lab::Frame;
+use example::lab::Frame;
 
 fn lab(args: &[&str]) -> (Outcome, String) {
     let mut out = Vec::new();
@@ -143,7 +143,7 @@ fn no_ball_is_ever_outside_the_play_area() {
     for screen in SCREENS {
         let args: Vec<&str> = screen.iter().copied().chain(["--until", "6"]).collect();
         let (o, _) = lab(&args);
-        let area = play_area(collision_lab::lab::screen_of(o.record.case));
+        let area = play_area(example::lab::screen_of(o.record.case));
         for f in &o.record.frames {
             for (k, b) in o.record.scene.balls.iter().enumerate() {
                 let p = f.states.pos[k];

@@ -7,9 +7,9 @@
     reason = "the example's `main` is not called: the test calls `tour`"
 )]
 #[path = "../examples/geometry_tour.rs"]
-mod geometry_tour;
+mod example;
 
-use geometry_tour::{RAMP_DEGREES, Scene, tour};
+use example::{RAMP_DEGREES, Scene, tour};
 
 /// The tour's output.
 fn output() -> String {

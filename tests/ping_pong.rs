@@ -9,14 +9,14 @@
     reason = "the example's `main` is not called: the tests call `run`"
 )]
 #[path = "../examples/ping_pong/main.rs"]
-mod ping_pong;
+mod example;
 
 use carom::integrate::Integrator;
 use carom::sim::Collision;
-use ping_pong::rally::{BALL_MASS, BALL_RADIUS, DRAG, Part, along_table, part};
-use ping_pong::run;
+use example::rally::{BALL_MASS, BALL_RADIUS, DRAG, Part, along_table, part};
+use example::run;
 
-fn rally(args: &[&str]) -> (ping_pong::Outcome, String) {
+fn rally(args: &[&str]) -> (example::Outcome, String) {
     let mut out = Vec::new();
     let o = run(args, &mut out).unwrap_or_else(|e| panic!("{args:?}: {e}"));
     (o, String::from_utf8(out).unwrap())

@@ -1,7 +1,7 @@
 //! The exact integrators (ballistic, linear drag, spin decay) against the textbook
 //! formulas, a fine RK4, their own group property and the limits they must reach.
 
-mod common;
+use crate::common;
 
 use carom_integrate::exact::{ballistic, linear_drag};
 use carom_integrate::{

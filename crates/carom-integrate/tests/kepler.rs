@@ -16,7 +16,7 @@
 //! where it started. [`semi_implicit_euler_has_effective_order_2_after_whole_periods`]
 //! shows it.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

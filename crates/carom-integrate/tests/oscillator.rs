@@ -14,7 +14,7 @@
 //! Every test measures the trajectory the stepper produces and compares it with these
 //! formulas, in 2D and 3D, `f64` and `f32`.
 
-mod common;
+use crate::common;
 
 use carom_integrate::{Integrator, Real, Space, Stepper, Vector};
 use common::{OneBall, oscillator, oscillator_energy, wide};

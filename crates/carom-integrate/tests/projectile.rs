@@ -17,7 +17,7 @@
 //! tolerance is a bound on the rounding of `n` additions, and each test also checks that
 //! the predicted error is far above that bound.
 
-mod common;
+use crate::common;
 
 use carom_integrate::{Gravity, Integrator, Real, Space, Stepper, Vector, exact};
 use common::{OneBall, wide};

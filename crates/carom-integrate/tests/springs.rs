@@ -2,7 +2,7 @@
 //! form (mass ratios up to 1e6), the stiff stability limits on the two-body mode,
 //! damping, energy behaviour of a chain, momentum, determinism and errors.
 
-mod common;
+use crate::common;
 
 use carom_integrate::{
     AnchorSpring, Attachment, Bodies, CoupledStepper, Gravity, Integrator, LinearDrag, Link,

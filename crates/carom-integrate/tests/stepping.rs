@@ -3,7 +3,7 @@
 //! drag, spin damping, a time-dependent user field) against closed forms and measured
 //! orders.
 
-mod common;
+use crate::common;
 
 use carom_integrate::{
     Acceleration, BallState, Bodies, CoupledStepper, Field, ForceField, Gravity, Integrator,

@@ -1,7 +1,7 @@
 //! Frictionless collisions against closed forms: the textbook 1D results, Collision Lab's
 //! normal/tangent decomposition, extreme mass ratios, walls and paddles.
 
-mod common;
+use crate::common;
 
 use carom_response::{Body, Coefficients, Contact, Outcome, central_impulse, resolve};
 use common::{TestBall, assert_close};

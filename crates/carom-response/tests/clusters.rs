@@ -1,7 +1,7 @@
 //! Stick collisions: fused clusters against hand computations and conservation laws,
 //! cluster–wall impulses at the contact point.
 
-mod common;
+use crate::common;
 
 use carom_response::{Body, Coefficients, Contact, Outcome, RigidCluster, resolve};
 use common::{TestBall, assert_close};

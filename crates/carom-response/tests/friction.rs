@@ -7,7 +7,7 @@
 //! `v_x + ω r = 0` this gives `v_x' = v_x / (1 + I/(m r²))`: `2/3 v_x` for a disk and
 //! `5/7 v_x` for a solid sphere.
 
-mod common;
+use crate::common;
 
 use carom_response::{Body, Coefficients, Contact, Friction, Outcome, resolve};
 use common::{TestBall, angular, assert_close};

@@ -5,7 +5,7 @@
 //! receding pair is never touched. Without friction, `central_impulse` gives `resolve`'s
 //! velocities to rounding.
 
-mod common;
+use crate::common;
 
 use carom_response::{
     Angular, Body, Coefficients, Contact, Friction, Outcome, Space, central_impulse, resolve,

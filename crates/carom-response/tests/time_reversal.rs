@@ -8,7 +8,7 @@
 //! identity where every intermediate is a dyadic rational (equal masses, head on).
 //! With `e < 1` or friction there is no reversal: the reversed pair loses energy again.
 
-mod common;
+use crate::common;
 
 use carom_response::{Angular, Body, Coefficients, Contact, Response, Space, resolve};
 use common::angular;

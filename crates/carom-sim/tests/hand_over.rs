@@ -2,7 +2,7 @@
 //! balls come to rest on each other (sustained contact): the exact run up to that
 //! instant, the stepped engine's from there, one clock, one summary.
 
-mod common;
+use crate::common;
 
 use carom_geometry::{Aabb, Border, Obb};
 use carom_math::Vector;

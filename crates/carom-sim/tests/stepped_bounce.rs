@@ -9,7 +9,7 @@
 //! at `h/2`. Both Euler schemes carry their first-order energy error (explicit Euler
 //! gains, semi-implicit Euler loses): the bounce heights converge at order 1.
 
-mod common;
+use crate::common;
 
 use carom_integrate::Integrator;
 use carom_sim::scenes::classic;

@@ -6,7 +6,7 @@
 //! bouncing between two parallel surfaces (a triangle wave), a paddle hitting a ball at
 //! rest (`(1 + e) u`), and a brute-force overlap check of every pair after every step.
 
-mod common;
+use crate::common;
 
 use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;

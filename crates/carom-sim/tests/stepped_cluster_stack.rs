@@ -30,7 +30,7 @@
 //! except a column standing exactly on one vertical line, where no horizontal component
 //! ever arises.
 
-mod common;
+use crate::common;
 
 use carom_geometry::Border;
 use carom_integrate::Integrator;

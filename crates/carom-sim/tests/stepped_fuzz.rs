@@ -23,7 +23,7 @@
 //! and, with a box added at the origin, in its own coordinates); and a light ball
 //! between two balls converging on it faster than the in-step time resolves.
 
-mod common;
+use crate::common;
 
 use carom_integrate::Integrator;
 use carom_math::{Real, Space};

@@ -2,7 +2,7 @@
 //! and 3 threads and across runs, and the step grid. (The gas's drift against rapier2d's on
 //! the same scene is tested in carom-report, which holds the rapier2d peer.)
 
-mod common;
+use crate::common;
 
 use carom_geometry::Obb;
 use carom_integrate::Integrator;

@@ -8,7 +8,7 @@
 //! integrator is exact; both Euler schemes lose speed too fast, explicit Euler overshoots
 //! in position and semi-implicit Euler falls short.
 
-mod common;
+use crate::common;
 
 use carom_integrate::Integrator;
 use carom_sim::Simulation;

@@ -1,7 +1,7 @@
 //! The stepped engine in the pipeline: the planner's choices, `build`, the driver of
 //! `carom run`, the pipeline names and the errors a bad request gets.
 
-mod common;
+use crate::common;
 
 use carom_geometry::Border;
 use carom_integrate::Integrator;

@@ -8,7 +8,7 @@
 //! about the contact point is conserved); a ball on a platform rising at constant speed
 //! moves with it.
 
-mod common;
+use crate::common;
 
 use carom_geometry::{Border, Obb};
 use carom_integrate::Integrator;

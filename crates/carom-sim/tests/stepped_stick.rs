@@ -4,7 +4,7 @@
 //! above 0, drag on a spinning cluster, backward runs, agreement with the exact event
 //! engine, and determinism.
 
-mod common;
+use crate::common;
 
 use carom_geometry::query::PointQuery;
 use carom_geometry::{Border, Obb};

@@ -10,7 +10,7 @@
 //! an error naming it when the box comes down parallel to the floor (as in the event
 //! engine: no impulse frees it).
 
-mod common;
+use crate::common;
 
 use carom_geometry::query::PointQuery;
 use carom_geometry::{Border, Obb};

@@ -2,7 +2,7 @@
 //! grazing by 1e-9 either way, gaps of 1e-12, 1e6 m/s, coordinates near 1e6, f32,
 //! backward time, common and differing accelerations.
 
-mod common;
+use crate::common;
 
 use approx::assert_relative_eq;
 use carom_geometry::Ball;

@@ -2,7 +2,7 @@
 //! linear and under gravity, rotated and moving boxes, starting inside; brute force for
 //! random ballistic cases.
 
-mod common;
+use crate::common;
 
 use approx::assert_relative_eq;
 use carom_geometry::{Aabb, Ball, Obb};

@@ -3,7 +3,7 @@
 //! 100-step bisection), agreement with the closed-form ball queries when nothing spins,
 //! and random cases against dense sampling.
 
-mod common;
+use crate::common;
 
 use approx::assert_relative_eq;
 use carom_geometry::{Ball, Border, HalfSpace};

@@ -1,7 +1,7 @@
 //! Ball against a plane, the walls of a border (with and without gravity, starting
 //! partly outside), and centre crossings of planes and levels (periodic cell faces).
 
-mod common;
+use crate::common;
 
 use approx::assert_relative_eq;
 use carom_geometry::{Ball, Border, HalfSpace};

@@ -1,8 +1,6 @@
 //! Helpers shared by the integration tests: running a stepper for many steps, the
 //! oscillator field, and fitting convergence orders.
 
-#![allow(dead_code)] // each test crate uses a different subset
-
 use carom_integrate::{
     AnchorSpring, Angular, Bodies, ForceField, Real, Space, Spring, Stepper, TimeStep, Vector,
 };

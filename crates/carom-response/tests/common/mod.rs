@@ -1,7 +1,6 @@
 //! Test helpers: balls with positions (which the response itself never needs) and the
 //! conserved quantities computed from masses and radii, independently of the impulse
 //! code's own energy bookkeeping.
-#![allow(dead_code)] // each test file uses a different subset
 
 use carom_response::{Angular, Body, Contact, Space};
 use nalgebra::{Const, SVector};

@@ -4,8 +4,6 @@
 //! sink, reading states, measuring how far balls stray out of the border, checking that
 //! a resting scene stays put.
 
-#![allow(dead_code)] // each test file uses a part
-
 use carom_integrate::Integrator;
 use carom_math::{Real, Space, Vector};
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};

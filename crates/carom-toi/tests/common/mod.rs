@@ -1,11 +1,14 @@
 //! Independent oracles shared by the integration tests: brute-force time sampling with
 //! bisection, and the naive reference motions.
-#![allow(dead_code, unreachable_pub)]
 
 /// The first time in `(0, horizon]` the gap goes from positive to negative, found by
 /// sampling `samples` equal steps and bisecting the first sign change (60 halvings).
 /// Misses dips shorter than a step: use it as "a contact the query must not miss".
-pub fn brute_first_descent(gap: impl Fn(f64) -> f64, horizon: f64, samples: usize) -> Option<f64> {
+pub(crate) fn brute_first_descent(
+    gap: impl Fn(f64) -> f64,
+    horizon: f64,
+    samples: usize,
+) -> Option<f64> {
     let mut armed = gap(0.0) > 0.0;
     let mut prev = 0.0;
     for i in 1..=samples {
@@ -39,7 +42,7 @@ fn last_apart(gap: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
 /// positive, or, for a gap never positive since 0, the first time it stops rising and
 /// falls (a pair overlapping and receding that turns back before it is apart), refined
 /// by golden-section search for the maximum. Returns the time and `true` for a turn.
-pub fn brute_first_contact(
+pub(crate) fn brute_first_contact(
     gap: impl Fn(f64) -> f64,
     horizon: f64,
     samples: usize,
@@ -74,7 +77,7 @@ pub fn brute_first_contact(
 
 /// Whether `t` is a turn of a gap never positive before it: no sample of `[0, t]` is
 /// above `1e-9`, and none is above the gap at `t` by more than `1e-9`.
-pub fn is_turn(gap: impl Fn(f64) -> f64, t: f64) -> bool {
+pub(crate) fn is_turn(gap: impl Fn(f64) -> f64, t: f64) -> bool {
     let highest = (0..=2000)
         .map(|i| gap(t * f64::from(i) / 2000.0))
         .fold(f64::NEG_INFINITY, f64::max);
@@ -82,7 +85,7 @@ pub fn is_turn(gap: impl Fn(f64) -> f64, t: f64) -> bool {
 }
 
 /// The smallest gap over `samples + 1` equally spaced times in `[a, b]`.
-pub fn min_gap(gap: impl Fn(f64) -> f64, a: f64, b: f64, samples: usize) -> f64 {
+pub(crate) fn min_gap(gap: impl Fn(f64) -> f64, a: f64, b: f64, samples: usize) -> f64 {
     (0..=samples)
         .map(|i| gap(a + (b - a) * i as f64 / samples as f64))
         .fold(f64::INFINITY, f64::min)

@@ -1,0 +1,18 @@
+//! The integration tests of carom-integrate: every integrator against closed forms
+//! (projectile, drag, oscillator, Kepler orbit, springs), error signs and fitted orders,
+//! and bodies stepped through the field and spring code.
+//!
+//! Each file of this directory is a module of one test binary, not a binary of its own: every
+//! integration-test binary links the workspace and monomorphises its generic engines anew,
+//! and one binary instead of many is what keeps the release build of `cargo test` (CI's
+//! longest step) short. Run one file's tests with `cargo test --release -p <crate> --test
+//! integration <file>::`.
+
+mod common;
+mod exact;
+mod fields;
+mod kepler;
+mod oscillator;
+mod projectile;
+mod springs;
+mod stepping;
