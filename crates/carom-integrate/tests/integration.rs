@@ -6,7 +6,9 @@
 //! integration-test binary links the workspace and monomorphises its generic engines anew,
 //! and one binary instead of many is what keeps the release build of `cargo test` (CI's
 //! longest step) short. Run one file's tests with `cargo test --release -p <crate> --test
-//! integration <file>::`.
+//! integration <file>::`. This root is not named `main.rs`: proptest keeps a file's failure
+//! seeds beside it (`boxes.rs`, `boxes.proptest-regressions`) only while no `main.rs` or
+//! `lib.rs` is found in a folder above the file.
 
 mod common;
 mod exact;
