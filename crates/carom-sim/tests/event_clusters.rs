@@ -3,18 +3,11 @@
 use carom_sim::plan::{BroadChoice, Plan};
 use carom_sim::scene::Inelastic;
 use carom_sim::scenes::collision_lab::{InelasticPreset, Options, Screen, scene};
-use carom_sim::{BallStates, Collision, EventEngine, Observer, Simulation};
+use carom_sim::{BallStates, Collision, EventEngine, Simulation};
 use carom_toi::Direction;
 use nalgebra::Vector2;
 
-#[derive(Default)]
-struct Log(Vec<Collision<f64>>);
-
-impl Observer<f64> for Log {
-    fn collision(&mut self, c: &Collision<f64>) {
-        self.0.push(*c);
-    }
-}
+use crate::common::{Recorder, states};
 
 fn plan() -> Plan {
     Plan::event(BroadChoice::Auto)
@@ -49,21 +42,15 @@ fn invariants(
     (p, l, e)
 }
 
-fn states(sim: &EventEngine<f64, 2>) -> BallStates<f64, 2> {
-    let mut st = BallStates::default();
-    sim.states(&mut st);
-    st
-}
-
 #[test]
 fn every_inelastic_preset_sticks_keeping_momentum_and_angular_momentum() {
     for preset in InelasticPreset::ALL {
         let s = stick(preset, false);
         let mut sim = EventEngine::new(&s, &plan(), Direction::Forward).unwrap();
         let (p0, l0, e0) = invariants(&s, &states(&sim));
-        let mut log = Log::default();
+        let mut log = Recorder::default();
         sim.advance_to(3.0, &mut log).unwrap();
-        assert_eq!(log.0.len(), 1, "{preset:?}: one stick collision");
+        assert_eq!(log.collisions.len(), 1, "{preset:?}: one stick collision");
         let st = states(&sim);
         let (p1, l1, e1) = invariants(&s, &st);
         assert!(
@@ -142,7 +129,7 @@ fn a_spinning_stuck_cluster_drifting_into_a_wall_bounces_and_never_leaves() {
     // drifts left, turning, into the left wall.
     let s = stick(InelasticPreset::Glancing, true);
     let mut sim = EventEngine::new(&s, &plan(), Direction::Forward).unwrap();
-    let mut log = Log::default();
+    let mut log = Recorder::default();
     let border = s.world.border.unwrap().border;
     for k in 1..=2000 {
         sim.advance_to(f64::from(k) * 0.01, &mut log).unwrap();
@@ -163,7 +150,7 @@ fn a_spinning_stuck_cluster_drifting_into_a_wall_bounces_and_never_leaves() {
     }
     // It drifts left at 0.14 m/s from x ≈ −0.65 and meets the left wall after ~7.7 s.
     assert!(
-        log.0
+        log.collisions
             .iter()
             .any(|c| matches!(c, Collision::BallBorder { .. })),
         "the cluster bounces off the wall"
@@ -203,11 +190,11 @@ fn a_cluster_landing_flat_on_a_wall_bounces_straight_back_without_spin() {
     // top wall at the same instant. The reaction acts below the centre of mass: no spin.
     let s = stick(InelasticPreset::CrissCross, true);
     let mut sim = EventEngine::new(&s, &plan(), Direction::Forward).unwrap();
-    let mut log = Log::default();
+    let mut log = Recorder::default();
     sim.advance_to(2.5, &mut log).unwrap();
     let st = states(&sim);
     assert!(
-        log.0
+        log.collisions
             .iter()
             .any(|c| matches!(c, Collision::BallBorder { .. }))
     );

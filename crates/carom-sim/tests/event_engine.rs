@@ -12,17 +12,10 @@ use carom_toi::Direction;
 use nalgebra::{Const, Vector2, Vector3};
 use proptest::prelude::*;
 
+use crate::common::{Recorder, advance, min_gap};
+
 fn plan(broad: BroadChoice) -> Plan {
     Plan::event(broad)
-}
-
-#[derive(Default)]
-struct Log(Vec<Collision<f64>>);
-
-impl Observer<f64> for Log {
-    fn collision(&mut self, c: &Collision<f64>) {
-        self.0.push(*c);
-    }
 }
 
 /// Runs `scene` to `t` (negative: backwards) and returns the final states and the log.
@@ -40,28 +33,7 @@ where
         Direction::Forward
     };
     let mut sim = EventEngine::new(scene, &plan(broad), direction).expect("a valid scene");
-    let mut log = Log::default();
-    sim.advance_to(t, &mut log).expect("the run completes");
-    let mut st = BallStates::default();
-    sim.states(&mut st);
-    (st, log.0)
-}
-
-/// The smallest surface gap between any two balls (minimum image in a periodic box).
-fn min_gap<const D: usize>(scene: &Scene<f64, D>, st: &BallStates<f64, D>) -> f64
-where
-    Const<D>: carom_math::Space<f64, D>,
-{
-    let periodic = scene.world.border.filter(|b| b.periodic).map(|b| b.border);
-    let mut gap = f64::INFINITY;
-    for i in 0..st.pos.len() {
-        for j in i + 1..st.pos.len() {
-            let d = st.pos[j] - st.pos[i];
-            let d = periodic.map_or(d, |b| b.minimum_image(&d));
-            gap = gap.min(d.norm() - scene.balls[i].radius - scene.balls[j].radius);
-        }
-    }
-    gap
+    advance(&mut sim, t)
 }
 
 #[test]
@@ -985,7 +957,7 @@ fn every_collision_lab_screen_runs_and_keeps_what_the_sim_teaches() {
                     let mut st = BallStates::default();
                     sim.states(&mut st);
                     let (e0, p0) = (energy(&s, &st), momentum(&s, &st));
-                    let mut log = Log::default();
+                    let mut log = Recorder::default();
                     sim.advance_to(10.0, &mut log).unwrap();
                     sim.states(&mut st);
                     let (e1, p1) = (energy(&s, &st), momentum(&s, &st));
@@ -998,7 +970,7 @@ fn every_collision_lab_screen_runs_and_keeps_what_the_sim_teaches() {
                         );
                     }
                     let walls = log
-                        .0
+                        .collisions
                         .iter()
                         .any(|c| matches!(c, Collision::BallBorder { .. }));
                     if !walls {

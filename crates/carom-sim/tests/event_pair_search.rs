@@ -10,9 +10,11 @@ use carom_math::{Space, Vector};
 use carom_sim::plan::{BroadChoice, Plan};
 use carom_sim::scene::{BallSpec, BorderSpec, Scene, World};
 use carom_sim::scenes::gas::{GasParams, gas};
-use carom_sim::{BallStates, Collision, EventEngine, Observer, PairSearch, Simulation};
+use carom_sim::{BallStates, Collision, EventEngine, PairSearch, Simulation};
 use carom_toi::Direction;
 use nalgebra::{Const, Vector2};
+
+use crate::common::{advance, min_gap};
 
 const SEARCHES: [PairSearch; 3] = [
     PairSearch::AllPairs,
@@ -22,15 +24,6 @@ const SEARCHES: [PairSearch; 3] = [
 
 fn plan() -> Plan {
     Plan::event(BroadChoice::Auto)
-}
-
-#[derive(Default)]
-struct Log(Vec<Collision<f64>>);
-
-impl Observer<f64> for Log {
-    fn collision(&mut self, c: &Collision<f64>) {
-        self.0.push(*c);
-    }
 }
 
 /// Runs `scene` to `t` with `search`: the collisions, the final states and the pipeline.
@@ -44,28 +37,8 @@ where
 {
     let mut sim = EventEngine::with_pair_search(scene, &plan(), Direction::Forward, search)
         .expect("a valid scene");
-    let mut log = Log::default();
-    sim.advance_to(t, &mut log).expect("the run completes");
-    let mut st = BallStates::default();
-    sim.states(&mut st);
-    (log.0, st, sim.pipeline())
-}
-
-/// The smallest surface gap between two balls (minimum image in a periodic box).
-fn min_gap<const D: usize>(scene: &Scene<f64, D>, st: &BallStates<f64, D>) -> f64
-where
-    Const<D>: Space<f64, D>,
-{
-    let periodic = scene.world.border.filter(|b| b.periodic).map(|b| b.border);
-    let mut gap = f64::INFINITY;
-    for i in 0..st.pos.len() {
-        for j in i + 1..st.pos.len() {
-            let d = st.pos[j] - st.pos[i];
-            let d = periodic.map_or(d, |b| b.minimum_image(&d));
-            gap = gap.min(d.norm() - scene.balls[i].radius - scene.balls[j].radius);
-        }
-    }
-    gap
+    let (st, log) = advance(&mut sim, t);
+    (log, st, sim.pipeline())
 }
 
 /// The time of a collision and what it involved, to compare logs.

@@ -1,8 +1,8 @@
-//! Helpers shared by the stepped-engine and hand-over tests: building an engine from a
-//! scene with given options, reading a 2D scene file, running a scene step by step with
-//! every integrator, collecting collisions, keeping what `carom run`'s driver hands its
-//! sink, reading states, measuring how far balls stray out of the border, checking that
-//! a resting scene stays put.
+//! Helpers shared by the engines' tests: building a stepped engine from a scene with given
+//! options, reading a 2D scene file, running a scene step by step with every integrator,
+//! running an engine to a time and collecting its collisions, keeping what `carom run`'s
+//! driver hands its sink, reading states, measuring how far balls stray out of the
+//! border or into each other, checking that a resting scene stays put.
 
 use carom_integrate::Integrator;
 use carom_math::{Real, Space, Vector};
@@ -147,6 +147,38 @@ impl<T: Real> Observer<T> for Recorder<T> {
     fn progress(&mut self, t: T) {
         self.progress.push(t);
     }
+}
+
+/// Runs `sim` to `t` (backwards for an engine built to run backwards): the final states
+/// and the collisions on the way.
+pub(crate) fn advance<T: Real, const D: usize>(
+    sim: &mut dyn Simulation<T, D>,
+    t: T,
+) -> (BallStates<T, D>, Vec<Collision<T>>)
+where
+    Const<D>: Space<T, D>,
+{
+    let mut rec = Recorder::default();
+    sim.advance_to(t, &mut rec).expect("the run completes");
+    (states(sim), rec.collisions)
+}
+
+/// The smallest surface gap between any two balls (minimum image in a periodic box),
+/// by brute force over every pair.
+pub(crate) fn min_gap<const D: usize>(scene: &Scene<f64, D>, st: &BallStates<f64, D>) -> f64
+where
+    Const<D>: Space<f64, D>,
+{
+    let periodic = scene.world.border.filter(|b| b.periodic).map(|b| b.border);
+    let mut gap = f64::INFINITY;
+    for i in 0..st.pos.len() {
+        for j in i + 1..st.pos.len() {
+            let d = st.pos[j] - st.pos[i];
+            let d = periodic.map_or(d, |b| b.minimum_image(&d));
+            gap = gap.min(d.norm() - scene.balls[i].radius - scene.balls[j].radius);
+        }
+    }
+    gap
 }
 
 /// A sink that keeps what [`carom_sim::run::drive`] hands it: every sample and, when
