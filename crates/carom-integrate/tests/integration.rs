@@ -2,13 +2,9 @@
 //! (projectile, drag, oscillator, Kepler orbit, springs), error signs and fitted orders,
 //! and bodies stepped through the field and spring code.
 //!
-//! Each file of this directory is a module of one test binary, not a binary of its own: every
-//! integration-test binary links the workspace and monomorphises its generic engines anew,
-//! and one binary instead of many is what keeps the release build of `cargo test` (CI's
-//! longest step) short. Run one file's tests with `cargo test --release -p <crate> --test
-//! integration <file>::`. This root is not named `main.rs`: proptest keeps a file's failure
-//! seeds beside it (`boxes.rs`, `boxes.proptest-regressions`) only while no `main.rs` or
-//! `lib.rs` is found in a folder above the file.
+//! The files beside this one are its modules: one test binary, not one per file (why, and
+//! why this root is not `main.rs`: ARCHITECTURE.md, "Decisions and why"). One file's tests:
+//! `cargo test --release -p carom-integrate --test integration <file>::`.
 
 mod common;
 mod exact;

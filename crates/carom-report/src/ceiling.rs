@@ -7,9 +7,9 @@
 //! 2026-11-29 (in reports, the stepped bench's table and alone), the compute loop scaled
 //! by 1.84–2.00× and the streaming loop by 1.44–1.73×; the random reads, the noisiest,
 //! by 1.80–2.01× in nine of them and 0.78–1.39× in three run right after a build, while
-//! the machine's load average was still above 1. Each loop here runs as two equal tasks, one after the other on a
-//! pool of one thread and at once on a pool of two, in alternating rounds; the ceiling is
-//! the median of the rounds' time ratios:
+//! the machine's load average was still above 1. Each loop here runs as two equal tasks,
+//! one after the other on a pool of one thread and at once on a pool of two, in
+//! alternating rounds; the ceiling is the median of the rounds' time ratios:
 //!
 //! * **compute**: a chain of square roots in registers, no memory traffic;
 //! * **streaming memory**: each task reads and rewrites its own buffer, larger than the
