@@ -7,7 +7,7 @@ use carom_sim::{BallStates, Collision, EventEngine, Simulation};
 use carom_toi::Direction;
 use nalgebra::Vector2;
 
-use crate::common::{Recorder, states};
+use crate::common::{Recorder, advance, states};
 
 fn plan() -> Plan {
     Plan::event(BroadChoice::Auto)
@@ -48,10 +48,8 @@ fn every_inelastic_preset_sticks_keeping_momentum_and_angular_momentum() {
         let s = stick(preset, false);
         let mut sim = EventEngine::new(&s, &plan(), Direction::Forward).unwrap();
         let (p0, l0, e0) = invariants(&s, &states(&sim));
-        let mut log = Recorder::default();
-        sim.advance_to(3.0, &mut log).unwrap();
-        assert_eq!(log.collisions.len(), 1, "{preset:?}: one stick collision");
-        let st = states(&sim);
+        let (st, log) = advance(&mut sim, 3.0);
+        assert_eq!(log.len(), 1, "{preset:?}: one stick collision");
         let (p1, l1, e1) = invariants(&s, &st);
         assert!(
             (p1 - p0).norm() < 1e-12,
@@ -190,12 +188,9 @@ fn a_cluster_landing_flat_on_a_wall_bounces_straight_back_without_spin() {
     // top wall at the same instant. The reaction acts below the centre of mass: no spin.
     let s = stick(InelasticPreset::CrissCross, true);
     let mut sim = EventEngine::new(&s, &plan(), Direction::Forward).unwrap();
-    let mut log = Recorder::default();
-    sim.advance_to(2.5, &mut log).unwrap();
-    let st = states(&sim);
+    let (st, log) = advance(&mut sim, 2.5);
     assert!(
-        log.collisions
-            .iter()
+        log.iter()
             .any(|c| matches!(c, Collision::BallBorder { .. }))
     );
     assert!(st.spin[0].x.abs() < 1e-12, "spin {}", st.spin[0].x);
