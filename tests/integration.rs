@@ -5,8 +5,8 @@
 //! why this root is not `main.rs`: ARCHITECTURE.md, "Decisions and why"). One file's tests:
 //! `cargo test --release -p carom --test integration <file>::`.
 
-// Each example is a program of its own and includes the shared picture code
-// (examples/common/picture.rs) itself; here two of them are modules of one binary.
+// Each example is a program of its own and includes the shared code of
+// examples/common/ (pictures, `main`) itself; here two of them are modules of one binary.
 #![allow(clippy::duplicate_mod)]
 
 mod collision_lab;

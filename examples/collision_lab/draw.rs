@@ -10,7 +10,8 @@ use plotters::prelude::*;
 
 use super::lab::{Record, case_name, cluster_spin, groups, is_1d, quantities, screen_of};
 use super::picture::{
-    Anchor, Animation, Canvas, Px, Raster, Series, View, ball_colour, darker, lighter, line_chart,
+    Anchor, Animation, Canvas, INK, MUTED, Px, Raster, Series, View, ball_colour, darker, lighter,
+    line_chart,
 };
 use super::report::{bodies_at, settings, title};
 use carom::sim::scenes::collision_lab::play_area;
@@ -20,8 +21,6 @@ const VELOCITY_SCALE: f64 = 0.4;
 /// Drawn length of a momentum arrow per kg·m/s (m).
 const MOMENTUM_SCALE: f64 = 0.4;
 
-const INK: RGBColor = RGBColor(40, 44, 52);
-const MUTED: RGBColor = RGBColor(110, 116, 128);
 const AREA: RGBColor = RGBColor(246, 248, 251);
 const GRID: RGBColor = RGBColor(226, 231, 238);
 const COM: RGBColor = RGBColor(60, 60, 60);
@@ -146,23 +145,8 @@ fn play(canvas: &Canvas<'_>, record: &Record, l: &Layout, layers: Layers) -> Dra
 
 /// The title, the settings and the time.
 fn header(canvas: &Canvas<'_>, record: &Record, l: &Layout, t: f64) -> Drawn {
-    // Header.
-    canvas.text(&title(record), (20.0, 22.0), 22.0, INK, Anchor::Left)?;
-    canvas.text(
-        &format!("{}; grid 0.5 m", settings(record)),
-        (20.0, 50.0),
-        14.0,
-        MUTED,
-        Anchor::Left,
-    )?;
-    canvas.text(
-        &format!("t = {t:.2} s"),
-        (f64::from(l.width) - 20.0, 22.0),
-        22.0,
-        INK,
-        Anchor::Right,
-    )?;
-    Ok(())
+    let settings = format!("{}; grid 0.5 m", settings(record));
+    canvas.header(&title(record), &settings, t, f64::from(l.width))
 }
 
 /// The play area with a 0.5 m grid, tick labels and its border.

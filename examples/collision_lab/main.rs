@@ -20,6 +20,8 @@
 //! a stuck cluster that only spins, next to a wall, bounces off it instead of passing
 //! through. See docs/examples.md for sample output and the pictures.
 
+#[path = "../common/cli.rs"]
+mod cli;
 mod draw;
 pub(crate) mod lab;
 #[path = "../common/picture.rs"]
@@ -253,17 +255,5 @@ pub(crate) fn run(args: &[&str], out: &mut dyn Write) -> Result<Outcome, Box<dyn
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let stdout = std::io::stdout();
-    match run(&args, &mut stdout.lock()) {
-        Ok(_) => ExitCode::SUCCESS,
-        Err(e) => {
-            if let Some(clap_error) = e.downcast_ref::<clap::Error>() {
-                clap_error.exit();
-            }
-            eprintln!("collision_lab: {e}");
-            ExitCode::from(2)
-        }
-    }
+    cli::main("collision_lab", run)
 }

@@ -37,6 +37,11 @@ pub(crate) fn register_font() {
     });
 }
 
+/// Titles and text.
+pub(crate) const INK: RGBColor = RGBColor(40, 44, 52);
+/// Settings, labels and ticks.
+pub(crate) const MUTED: RGBColor = RGBColor(110, 116, 128);
+
 /// Colours for balls: the Okabe–Ito palette, readable for colour-blind viewers.
 pub(crate) const BALL_COLOURS: [RGBColor; 8] = [
     RGBColor(230, 159, 0),
@@ -341,6 +346,20 @@ impl<'a> Canvas<'a> {
                 (base.0 + uy * half, base.1 - ux * half),
             ],
             colour,
+        )
+    }
+
+    /// A picture's header on a canvas `width` logical pixels wide: the title and, under
+    /// it, the settings on the left, the time `t` (s) on the right.
+    pub(crate) fn header(&self, title: &str, settings: &str, t: f64, width: f64) -> Drawn {
+        self.text(title, (20.0, 22.0), 22.0, INK, Anchor::Left)?;
+        self.text(settings, (20.0, 50.0), 14.0, MUTED, Anchor::Left)?;
+        self.text(
+            &format!("t = {t:.2} s"),
+            (width - 20.0, 22.0),
+            22.0,
+            INK,
+            Anchor::Right,
         )
     }
 

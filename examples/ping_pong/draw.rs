@@ -10,12 +10,11 @@ use nalgebra::Vector3;
 use plotters::prelude::*;
 
 use super::picture::{
-    Anchor, Animation, Canvas, Px, Raster, Series, View, ball_colour, darker, lighter, line_chart,
+    Anchor, Animation, Canvas, INK, MUTED, Px, Raster, Series, View, ball_colour, darker, lighter,
+    line_chart,
 };
 use super::rally::{BALL_RADIUS, Frame, NET_HEIGHT, Part, Rally, TABLE, energies, part};
 
-const INK: RGBColor = RGBColor(40, 44, 52);
-const MUTED: RGBColor = RGBColor(110, 116, 128);
 const TABLE_BLUE: RGBColor = RGBColor(28, 78, 128);
 const FLOOR: RGBColor = RGBColor(246, 248, 251);
 
@@ -244,29 +243,15 @@ fn views(canvas: &Canvas<'_>, frame: &Frame, rally: &Rally, upto: usize, width: 
 }
 
 fn header(canvas: &Canvas<'_>, rally: &Rally, upto: usize, width: f64) -> Drawn {
-    canvas.text(
+    let settings = format!(
+        "{} at step {} s; ○ contacts (red: paddle, black: ball–ball); red arc: the paddle's swing",
+        rally.integrator, rally.dt
+    );
+    canvas.header(
         "Ping pong on carom's stepped engine: tilted table (OBB), net, side walls, swung paddle, 3 balls",
-        (20.0, 22.0),
-        22.0,
-        INK,
-        Anchor::Left,
-    )?;
-    canvas.text(
-        &format!(
-            "{} at step {} s; ○ contacts (red: paddle, black: ball–ball); red arc: the paddle's swing",
-            rally.integrator, rally.dt
-        ),
-        (20.0, 50.0),
-        14.0,
-        MUTED,
-        Anchor::Left,
-    )?;
-    canvas.text(
-        &format!("t = {:.2} s", rally.frames[upto].0),
-        (width - 20.0, 22.0),
-        22.0,
-        INK,
-        Anchor::Right,
+        &settings,
+        rally.frames[upto].0,
+        width,
     )
 }
 

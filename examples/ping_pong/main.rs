@@ -11,6 +11,8 @@
 //!
 //! The scene's numbers and their sources are in `rally.rs`. See docs/examples.md.
 
+#[path = "../common/cli.rs"]
+mod cli;
 mod draw;
 #[allow(
     dead_code,
@@ -264,17 +266,5 @@ fn print_energy(reference: &Rally, rallies: &[Rally], out: &mut dyn Write) -> st
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let stdout = std::io::stdout();
-    match run(&args, &mut stdout.lock()) {
-        Ok(_) => ExitCode::SUCCESS,
-        Err(e) => {
-            if let Some(clap_error) = e.downcast_ref::<clap::Error>() {
-                clap_error.exit();
-            }
-            eprintln!("ping_pong: {e}");
-            ExitCode::from(2)
-        }
-    }
+    cli::main("ping_pong", run)
 }
