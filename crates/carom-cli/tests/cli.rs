@@ -227,6 +227,7 @@ fn bad_flags_exit_2() {
     assert!(failure(&["run", p, "--until", "nan"]).contains("--until"));
     assert!(failure(&["run", p]).contains("--until"));
     assert!(failure(&["run", p, "--until", "1", "--threads", "0"]).contains("--threads"));
+    assert!(failure(&["run", p, "--until", "1", "--threads", "100000"]).contains("--threads"));
 }
 
 #[test]
