@@ -247,4 +247,10 @@ fn a_ball_smaller_than_the_precision_resolves_where_it_is_is_refused_naming_its_
         panic!("a 2D scene")
     };
     s.cast::<f32>().expect("resolved near the origin");
+    // In f64 the same balls at 1e14 m are beyond f64's resolution too (0.18 m there):
+    // the message does not send the user to the precision already in use.
+    let e = parse_scene(&small_balls_at(-1e14)).expect_err("too small for f64 there");
+    assert_eq!(e.field, "balls[0].radius", "{e}");
+    assert!(e.message.contains("coordinates nearer the origin"), "{e}");
+    assert!(!e.message.contains("--precision"), "{e}");
 }

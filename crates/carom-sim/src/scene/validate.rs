@@ -112,12 +112,18 @@ impl<T: Real, const D: usize> Scene<T, D> {
         });
         let largest = (self.balls.iter()).fold(border, |m, b| m.max(b.pos.amax()));
         let resolution = coordinate_resolution(largest);
+        // Only a precision coarser than `f64` can be helped by `f64`.
+        let remedy = if T::EPSILON.to_f64() > f64::EPSILON {
+            "use --precision f64 or coordinates nearer the origin"
+        } else {
+            "use coordinates nearer the origin"
+        };
         match self.balls.iter().position(|b| b.radius < resolution) {
             None => Ok(()),
             Some(i) => Err(SceneError::new(
                 format!("balls[{i}].radius"),
                 format!(
-                    "{} m is below what this precision resolves at coordinates of {} m ({} m): its contacts could not be found; use --precision f64 or coordinates nearer the origin",
+                    "{} m is below what this precision resolves at coordinates of {} m ({} m): its contacts could not be found; {remedy}",
                     self.balls[i].radius, largest, resolution
                 ),
             )),
