@@ -54,8 +54,10 @@ pub(crate) struct RunArgs {
     /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
-    /// Sample times, comma separated.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    /// Sample times, comma separated (negative for a backward run).
+    // `allow_negative_numbers` alone takes `-0.5` but not `-0.25,-0.5` (not a number as
+    // a whole, so clap read it as a flag): the value is taken whatever it starts with.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     at: Vec<f64>,
     /// Also sample every S seconds, from 0.
     #[arg(long)]

@@ -151,6 +151,33 @@ fn a_backward_run_then_forward_returns_to_the_start() {
     }
 }
 
+/// A backward run's sample times are negative, and a list of them is read as one value
+/// (clap once took `-0.25,-0.5` for a flag), in the run's order: the ball at 1 m/s is
+/// where `v t` puts it at each.
+#[test]
+fn a_backward_run_takes_a_list_of_negative_sample_times() {
+    let path = scene_file("intro-back-at.toml", INTRO);
+    let out = lines(&carom(&[
+        "run",
+        path.to_str().unwrap(),
+        "--until",
+        "-0.5",
+        "--at",
+        "-0.25,-0.125",
+    ]));
+    let times: Vec<f64> = out[..out.len() - 1]
+        .iter()
+        .map(|l| l["t"].as_f64().unwrap())
+        .collect();
+    assert_eq!(times, vec![-0.125, -0.25, -0.5]);
+    for l in &out[..out.len() - 1] {
+        let t = l["t"].as_f64().unwrap();
+        // Ball 0 starts at -1 m moving at 1 m/s and meets nothing within 0.5 s back.
+        let x = l["pos"][0][0].as_f64().unwrap();
+        assert!((x - (-1.0 + t)).abs() < 1e-12, "{l}");
+    }
+}
+
 #[test]
 fn f32_precision_prints_single_precision_numbers() {
     let path = scene_file("intro-f32.toml", INTRO);
