@@ -165,12 +165,10 @@ fn a_backward_run_takes_a_list_of_negative_sample_times() {
         "--at",
         "-0.25,-0.125",
     ]));
-    let times: Vec<f64> = out[..out.len() - 1]
-        .iter()
-        .map(|l| l["t"].as_f64().unwrap())
-        .collect();
+    let samples = &out[..out.len() - 1];
+    let times: Vec<f64> = samples.iter().map(|l| l["t"].as_f64().unwrap()).collect();
     assert_eq!(times, vec![-0.125, -0.25, -0.5]);
-    for l in &out[..out.len() - 1] {
+    for l in samples {
         let t = l["t"].as_f64().unwrap();
         // Ball 0 starts at -1 m moving at 1 m/s and meets nothing within 0.5 s back.
         let x = l["pos"][0][0].as_f64().unwrap();

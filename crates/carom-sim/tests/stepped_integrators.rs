@@ -12,6 +12,7 @@ use crate::common;
 
 use carom_integrate::Integrator;
 use carom_sim::Simulation;
+use carom_sim::plan::BroadChoice;
 use carom_sim::scene::{BallSpec, Scene, World};
 use carom_toi::Direction;
 use common::{states, stepped, stepped_with};
@@ -144,7 +145,7 @@ fn a_backward_run_under_drag_follows_the_reversed_closed_form() {
         &s,
         Integrator::Exact,
         0.01,
-        carom_sim::plan::BroadChoice::Auto,
+        BroadChoice::Auto,
         Direction::Backward,
     );
     sim.advance_to(t, &mut ()).unwrap();
@@ -161,7 +162,7 @@ fn a_backward_run_under_drag_follows_the_reversed_closed_form() {
         &s,
         Integrator::Rk4,
         0.01,
-        carom_sim::plan::BroadChoice::Auto,
+        BroadChoice::Auto,
         Direction::Backward,
     );
     sim.advance_to(t, &mut ()).unwrap();
@@ -201,16 +202,12 @@ fn a_long_f32_run_reaches_its_target_time_not_steps_short_of_it() {
     };
     let s: Scene<f32, 2> = s64.cast().unwrap();
     for direction in [Direction::Forward, Direction::Backward] {
-        let sign = if direction == Direction::Forward {
-            1.0
-        } else {
-            -1.0
-        };
+        let sign = direction.sign::<f64>();
         let mut sim = stepped_with(
             &s,
             Integrator::SemiImplicitEuler,
             0.01,
-            carom_sim::plan::BroadChoice::Auto,
+            BroadChoice::Auto,
             direction,
         );
         for t in [5000.0, 12_345.678, 20_000.0] {

@@ -146,9 +146,9 @@ pub struct StepStats {
     pub frozen_time: f64,
 }
 
-/// The most steps of the grid a run may reach: `2⁵³`, the last integer an `f64` counts
-/// exactly (see [`Clock::grid`]).
-const MAX_GRID_STEPS: f64 = 9_007_199_254_740_992.0;
+/// The most steps of the grid a run may reach: `2⁵³`, past which an `f64` no longer
+/// counts every integer (see [`Clock::grid`]).
+const MAX_GRID_STEPS: f64 = (1u64 << f64::MANTISSA_DIGITS) as f64;
 
 /// The step grid: internal time `s` (forward in the run's direction), grid times `k·dt`.
 #[derive(Clone, Copy, Debug)]
