@@ -94,7 +94,12 @@ where
                             self.balls.position_at(j, now),
                         );
                         let offset = self.separation(&a, &b);
-                        self.refuse_sunken_pair(i, j, &offset, a.amax().max(b.amax()))?;
+                        self.refuse_sunken_pair(
+                            i,
+                            j,
+                            &offset,
+                            self.scene_amax(&a).max(self.scene_amax(&b)),
+                        )?;
                         self.pair_pressing(i, j, &offset)
                     } else {
                         None
@@ -418,7 +423,7 @@ where
         let mut e = self.surface_restitution(i, surface_restitution);
         let pressing = self.gravity.dot(&normal);
         // The heights the ball's position can resolve.
-        let resolution = coordinate_resolution(self.balls.motion[i].pos.amax());
+        let resolution = coordinate_resolution(self.scene_amax(&self.balls.motion[i].pos));
         let stops = self
             .resting
             .decide_resolved(approach, e, pressing, resolution)

@@ -23,6 +23,11 @@
 //! Time runs backwards (`carom run --until -T`) by running forwards with every velocity
 //! negated (gravity unchanged: `x(−s) = x₀ − v₀ s + g s²/2`) and reporting times and
 //! velocities with their sign flipped.
+//!
+//! Positions are computed from the scene's middle ([`Scene::recentred`]) and reported
+//! from its origin, so a scene far from the origin is simulated as finely as its size
+//! allows; the guards that depend on what positions resolve keep the scene's own
+//! scales (docs/event-engine.md, "Coordinates").
 
 pub mod calendar;
 pub mod cells;
@@ -215,6 +220,10 @@ where
 {
     /// `+1` forward, `−1` backward: reported time = sign · internal time.
     sign: T,
+    /// Where the scene's origin is in the engine's coordinates: positions are computed
+    /// from the scene's middle, finer far from the origin, and reported with this added
+    /// back ([`Scene::recentred`]).
+    origin: Vector<T, D>,
     gravity: Vector<T, D>,
     border: Option<Border<T, D>>,
     border_restitution: T,
@@ -298,6 +307,13 @@ where
                 format!("the event-driven engine cannot run this scene: {why}"),
             ));
         }
+        // The guards' scales are the scene's own: its coordinates resolve no finer than
+        // they did as given (see `resolution_at`).
+        let scale = length_scale(scene);
+        let instant = instant_width(scene, scale);
+        // Positions are computed from the scene's middle and reported from the origin.
+        let (scene, origin) = scene.recentred();
+        let scene = &scene;
         let sign = direction.sign::<T>();
         let n = scene.balls.len();
         let balls = Balls {
@@ -345,9 +361,9 @@ where
                 restitution: b.restitution,
             })
             .collect();
-        let scale = length_scale(scene);
         let mut engine = Self {
             sign,
+            origin,
             gravity: scene.world.gravity,
             border,
             border_restitution,
@@ -368,7 +384,7 @@ where
             now: T::zero(),
             counters: Counters::default(),
             events_at_instant: 0,
-            instant_width: instant_width(scene, scale),
+            instant_width: instant,
             resting_pair: None,
             held: None,
             wedged: None,
@@ -575,6 +591,15 @@ where
         }
     }
 
+    /// The largest coordinate of `x` (engine coordinates) in the scene's own
+    /// coordinates: the guards that depend on what positions resolve use it, so that
+    /// they hold as far as they did before the scene was moved to its middle (the
+    /// arithmetic is finer there, but the scene's tolerances were tuned to what its
+    /// own coordinates resolve).
+    fn scene_amax(&self, x: &Vector<T, D>) -> T {
+        (x + self.origin).amax()
+    }
+
     /// The state of ball `i` now, in reported (signed) terms.
     fn reported_state(&self, i: usize) -> (Vector<T, D>, Vector<T, D>) {
         if let Mode::Stuck(c) = self.balls.mode[i] {
@@ -677,7 +702,7 @@ where
         out.reset(n);
         for i in 0..n {
             let (p, v) = self.reported_state(i);
-            out.pos.push(p);
+            out.pos.push(p + self.origin);
             out.vel.push(v);
             let spin = match self.balls.mode[i] {
                 Mode::Stuck(c) => self.clusters[c].rigid.angular_velocity(),
