@@ -372,7 +372,7 @@ impl<T: Real> Calendar<T> {
     }
 
     /// Puts `ball`, whose time is set, into the heap; rebuilds the heap from its live
-    /// entries when the dead ones outnumber them.
+    /// entries, one per ball, when the others outnumber them.
     fn heap_push(&mut self, ball: u32) {
         self.slot[ball as usize] = Slot::Heap;
         self.heap_live += 1;
@@ -389,6 +389,12 @@ impl<T: Real> Calendar<T> {
                     core::cmp::Ordering::Equal
                 }
             });
+            // A ball rescheduled at the time it had leaves equal entries, all live; they
+            // lie side by side once sorted, and one stands for the ball. Kept, they made
+            // every push of a cascade at one instant rebuild a heap that only grew: a
+            // fuzzed scene's wedged ball (23 balls) crawled at 15,000 events a second,
+            // 96 % of it in this sort.
+            self.heap.dedup_by_key(|e| e.ball);
         }
         let entry = Entry {
             time: self.time[ball as usize],
@@ -560,6 +566,27 @@ mod tests {
         assert_eq!(c.pop(), Some((1, 0.1)));
         assert_eq!(c.pop(), Some((2, 0.2)));
         assert_eq!(c.pop(), Some((0, 0.5 + 1e-6 * 999.0)));
+        assert_eq!(c.pop(), None);
+    }
+
+    #[test]
+    fn rescheduling_at_the_same_instant_keeps_the_heap_small() {
+        // A cascade at one instant: every event at the same time, each ball rescheduled
+        // at that time again and again. Each rescheduling leaves an entry equal to the
+        // new one (both live); the heap keeps one per ball at its rebuilds.
+        let mut c = Calendar::<f64>::new(3, 4, 1.0, 0.0);
+        for ball in 0..3 {
+            c.schedule(ball, 0.5);
+        }
+        assert_eq!(c.peek(), Some((0, 0.5)));
+        for k in 0..3000 {
+            c.schedule(k % 3, 0.5);
+            assert!(c.heap.len() <= 2 * 3 + 16, "{} entries", c.heap.len());
+        }
+        // Each ball pops once, in index order, then the calendar is empty.
+        assert_eq!(c.pop(), Some((0, 0.5)));
+        assert_eq!(c.pop(), Some((1, 0.5)));
+        assert_eq!(c.pop(), Some((2, 0.5)));
         assert_eq!(c.pop(), None);
     }
 
