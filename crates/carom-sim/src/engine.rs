@@ -180,7 +180,8 @@ pub struct SimError {
 pub enum SimErrorKind {
     /// The engine cannot continue this run (the message says why).
     Failed,
-    /// Bodies came to press on each other under gravity (a stack, a pile, a wedge):
+    /// Bodies came to press on each other (under gravity a stack, a pile, a wedge;
+    /// without it a light ball pinned between heavier bodies, walls or a moving box):
     /// sustained contact, which no finite sequence of exact events resolves and the
     /// time-stepped engine simulates. The state at the error's time is consistent
     /// (every ball where its motion puts it, nothing overlapping), so the run can go on

@@ -2,8 +2,9 @@
 //!
 //! `--engine auto` runs a scene on the exact event-driven engine whenever the scene can
 //! start there. A scene can still come to need what that engine cannot do: balls
-//! dropped under gravity settle into a pile, sustained contact that no finite sequence
-//! of exact events resolves. The event engine then stops with a
+//! dropped under gravity settle into a pile, or, without gravity, a light ball ends up
+//! pinned between heavier bodies: sustained contact that no finite sequence of exact
+//! events resolves. The event engine then stops with a
 //! [`SimErrorKind::SustainedContact`] error, its state consistent at that instant.
 //! [`EventThenStepped`] is the engine `auto` builds: it runs the event engine, and at
 //! such an error builds the time-stepped engine from the scene as it stands at that

@@ -8,7 +8,7 @@ use carom_geometry::{Aabb, Border, Obb};
 use carom_math::Vector;
 use carom_sim::plan::{BroadChoice, Plan, RunOptions, plan};
 use carom_sim::run::{Summary, drive, sample_times};
-use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, Scene, World};
+use carom_sim::scene::{BallSpec, BorderSpec, BoxSpec, LoadedScene, Scene, World, parse_scene};
 use carom_sim::{BallStates, Collision, EngineKind, SimErrorKind, build};
 use carom_toi::Direction;
 use common::Keep;
@@ -319,5 +319,57 @@ fn a_ball_pivoting_over_a_box_corner_is_handed_over_and_leaves_at_the_closed_for
             dx.hypot(dy) >= R - 1e-8,
             "t = {t}: the ball at ({x}, {y}) enters the box"
         );
+    }
+}
+
+/// Without gravity too: a fuzzed scene (`tests/scenes/light_ball_pinned_without_gravity.toml`)
+/// whose light ball ends up pinned between a ball 4e8 times heavier and the border,
+/// run backwards. The event engine ends it with an endless cascade at one instant,
+/// sustained contact (before, a failure `auto` did not hand over: the run ended there,
+/// as it did after a crawl of more than a minute before the calendar kept one heap
+/// entry per ball); under `auto` the stepped engine runs on from that instant to the
+/// end, every ball inside the border and the energy never above the hand-over's (the
+/// collisions lose energy: restitution 0.19 and 0.5, friction).
+#[test]
+fn a_light_ball_pinned_without_gravity_is_handed_over_to_the_stepped_engine() {
+    let LoadedScene::D2(scene) = parse_scene(include_str!(
+        "scenes/light_ball_pinned_without_gravity.toml"
+    ))
+    .unwrap() else {
+        panic!("a 2D scene")
+    };
+    assert_eq!(scene.world.gravity, Vector::<f64, 2>::zeros());
+    let mut exact = build(&scene, &Plan::event(BroadChoice::Auto), Direction::Backward).unwrap();
+    let err = exact.advance_to(-0.05, &mut ()).unwrap_err();
+    assert_eq!(err.kind, SimErrorKind::SustainedContact, "{err}");
+    assert!(
+        err.message.contains("at one instant") && err.message.contains("without gravity"),
+        "{err}"
+    );
+    assert!((err.time + 6.6037e-4).abs() < 1e-8, "{err}");
+    let mut at_hand_over = BallStates::default();
+    exact.states(&mut at_hand_over);
+
+    let (summary, keep) = run_auto(&scene, -0.05, 0.01);
+    let handed = summary.hand_over.as_ref().expect("the run was handed over");
+    assert_eq!((handed.time, &handed.reason), (err.time, &err.message));
+    assert_eq!(summary.engine, EngineKind::Stepped);
+    assert_eq!(keep.samples.last().map(|(t, _)| *t), Some(-0.05));
+    let energy = |st: &BallStates<f64, 2>| carom_sim::observe::energy(&scene, st);
+    let start = energy(&at_hand_over);
+    let border = scene.world.border.unwrap().border;
+    for (t, st) in &keep.samples {
+        if *t < handed.time {
+            assert!(energy(st) <= start * (1.0 + 1e-9), "t = {t}: energy rose");
+        }
+        for (p, b) in st.pos.iter().zip(&scene.balls) {
+            for k in 0..2 {
+                assert!(
+                    p[k] - b.radius >= border.min()[k] - 1e-9
+                        && p[k] + b.radius <= border.max()[k] + 1e-9,
+                    "t = {t}: a ball outside the border"
+                );
+            }
+        }
     }
 }
