@@ -1091,7 +1091,7 @@ const WEDGE_SCENE: &str = include_str!("scenes/corner_crush.toml");
 /// scene is computed from its middle (`Scene::recentred`), where the squeeze closes in
 /// ever shorter rounds and ends as a cascade of events at one instant; the same crush in
 /// a border that reaches across the origin on y (so that axis keeps the coordinates'
-/// own resolution, 7e-12 m at 5e4 m, and the ball hops at it) ends by the wedge rule,
+/// own unit, 7.3e-12 m at 5e4 m, and the ball hops at it) ends by the wedge rule,
 /// 4,096 surface contacts in a row.
 #[test]
 fn a_ball_wedged_between_surfaces_ends_the_run_as_sustained_contact_not_a_crawl() {
@@ -1103,20 +1103,16 @@ fn a_ball_wedged_between_surfaces_ends_the_run_as_sustained_contact_not_a_crawl(
             assert!(self.0 < 1_000_000, "a million events and the run goes on");
         }
     }
-    let LoadedScene::D2(recentred) = parse_scene(WEDGE_SCENE).unwrap() else {
+    let LoadedScene::D2(crush) = parse_scene(WEDGE_SCENE).unwrap() else {
         panic!("a 2D scene")
     };
-    let mut coarse_y = recentred.clone();
+    let mut coarse_y = crush.clone();
     let spec = coarse_y.world.border.as_mut().unwrap();
     spec.border = Border::new(spec.border.min(), Vector2::new(spec.border.max().x, 5e4)).unwrap();
-    assert_eq!(
-        recentred.middle().y,
-        -5e4,
-        "the crush is moved to its middle"
-    );
+    assert_eq!(crush.middle().y, -5e4, "the crush is moved to its middle");
     assert_eq!(coarse_y.middle().y, 0.0, "the tall border keeps y's origin");
     for (scene, guard) in [
-        (&recentred, "more than 260 events at one instant"),
+        (&crush, "more than 260 events at one instant"),
         (&coarse_y, "ball 3 is wedged: 4096 contacts"),
     ] {
         let mut sim =

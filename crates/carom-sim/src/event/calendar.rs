@@ -392,8 +392,8 @@ impl<T: Real> Calendar<T> {
             // A ball rescheduled at the time it had leaves equal entries, all live; they
             // lie side by side once sorted, and one stands for the ball. Kept, they made
             // every push of a cascade at one instant rebuild a heap that only grew: a
-            // fuzzed scene's wedged ball (23 balls) crawled at 15,000 events a second,
-            // 96 % of it in this sort.
+            // fuzzed scene's pinned ball (23 balls) crawled at 15,000 events a second,
+            // 96 % of it in this rebuild.
             self.heap.dedup_by_key(|e| e.ball);
         }
         let entry = Entry {

@@ -307,8 +307,8 @@ where
                 format!("the event-driven engine cannot run this scene: {why}"),
             ));
         }
-        // The guards' scales are the scene's own: its coordinates resolve no finer than
-        // they did as given (see `resolution_at`).
+        // The guards' scales are the scene's own: they were tuned to what its coordinates
+        // resolve as given (see `scene_amax`).
         let scale = length_scale(scene);
         let instant = instant_width(scene, scale);
         // Positions are computed from the scene's middle and reported from the origin.
