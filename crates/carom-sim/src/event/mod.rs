@@ -678,7 +678,7 @@ where
                 // Under gravity, balls pressed together; without it, a light ball pinned
                 // between heavier bodies, walls or a box. Either is sustained contact:
                 // the stepped engine simulates it (fuzzed cascades without gravity that
-                // end here ran 2 s on it in 0.03-0.2 s) or names the crush.
+                // end here ran 2 s on it in 0.03-0.21 s) or names the crush.
                 let why = if self.balls.accelerated {
                     "under gravity this is usually balls pressed together (a stack, a pile, a wedge)"
                 } else {
