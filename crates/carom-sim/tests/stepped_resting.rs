@@ -580,6 +580,29 @@ fn a_packed_pyramid_too_large_for_the_exact_solver_stays_put() {
 /// 11 mm/s at 4.5 s and 0.18 m/s at 8 s.)
 #[test]
 fn a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest() {
+    let largest = drop_rows_of_balls(6, 0.0);
+    assert!(largest > 64, "the largest hold took {largest} contacts");
+}
+
+/// As [`a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest`] with 12 rows
+/// (192 balls), whose pile is held in holds of more than `SPARSE_ROWS` (256) contacts,
+/// solved sparsely: at each step's start with up to 128 friction rounds, and again
+/// after each contact of two of its balls that the pile cannot take as a surface
+/// (balls bouncing in it), each of those with up to 16 rounds started from the forces of
+/// the holds before. The same bounds hold every step, but for the energy's: a sparse
+/// solve ends within a tolerance, not exactly, and its rises are allowed up to 1e-7 of
+/// the pile's energy a step (about 6e-4 J here; the largest measured was 8.4e-5 J, and
+/// 7.3e-6 J with 128 rounds in every hold, which the exact bound, 6.4e-6 J, refuses too).
+#[test]
+fn a_pile_held_in_sparse_holds_lands_apart_inside_and_comes_to_rest() {
+    let largest = drop_rows_of_balls(12, 1e-7);
+    assert!(largest > 256, "the largest hold took {largest} contacts");
+}
+
+/// Drops `rows` rows of 16 balls as the tests above describe, checks every step's
+/// bounds (the energy allowed to rise by `solve_tolerance` of itself more than the
+/// narrow phase allows), and returns the largest hold's contacts.
+fn drop_rows_of_balls(rows: u32, solve_tolerance: f64) -> u64 {
     let mut seed = 0x2545_f491_4f6c_dd1d_u64;
     let mut uniform = move || {
         seed ^= seed << 13;
@@ -588,7 +611,7 @@ fn a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest() {
         (seed >> 11) as f64 / (1_u64 << 53) as f64
     };
     let mut balls = Vec::new();
-    for row in 0..6 {
+    for row in 0..rows {
         for k in 0..16 {
             let x = -4.7 + 0.625 * f64::from(k) + 0.1 * (uniform() - 0.5);
             let vel = Vector2::new(2.0 * uniform() - 1.0, 0.0);
@@ -632,7 +655,7 @@ fn a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest() {
         );
         let e = observe::energy(&s, &st);
         assert!(
-            e <= before + weight * sink,
+            e <= before + weight * sink + solve_tolerance * before,
             "step {k}: energy {before} -> {e}"
         );
         before = e;
@@ -642,6 +665,5 @@ fn a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest() {
         later <= at_rest * (1.0 + 1e-6),
         "the pile creeps: its fastest ball went from {at_rest} m/s at 4 s to {later} at 5 s"
     );
-    let largest = sim.stats().largest_hold;
-    assert!(largest > 64, "the largest hold took {largest} contacts");
+    sim.stats().largest_hold
 }

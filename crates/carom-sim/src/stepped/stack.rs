@@ -43,7 +43,7 @@
 //! million times heavier than the one it rests on is held in one solve. With friction the
 //! normal impulses and the tangential ones (Coulomb's cone, projected Gauss–Seidel) are
 //! solved in turn until they agree (staggered projections), up to 32 rounds (128 in a
-//! hold solved sparsely); under
+//! hold solved sparsely at the step's start, 16 in one within the step); under
 //! gravity, rounds that end with friction still moving end with the normal impulses once
 //! more, so that the hold leaves nothing closing. In a pile's hold each round after the
 //! first solves again from the last one's passive set (`Lcp::resolve`: only the margins
@@ -144,6 +144,18 @@ const FRICTION_ROUNDS: usize = 32;
 /// pile's 300 steps against 116 s with 32 when each new guess was factored, 154–164 s
 /// since (`docs/stepped.md`).
 const SPARSE_FRICTION_ROUNDS: usize = 128;
+
+/// The rounds of a hold solved sparsely within the step (`s > 0`: after a contact of
+/// one of its balls, a pile held again), which start from the forces the same rows took
+/// in the step's earlier holds (`Warm`): friction goes on converging from hold to hold,
+/// and the next step's first hold runs all [`SPARSE_FRICTION_ROUNDS`]. While the
+/// 480-ball pile lands it is held again some 20 to 130 times a step, and with 128
+/// rounds each such hold ran nearly all of them: its 300 steps took 336 s, 129 s with
+/// 16 (the landing 309 s and 99 s). What it costs: friction that has not converged
+/// adds a little energy now and then (the largest rise in a step 2.1e-4 J against
+/// 1.2e-4 J, in a variant with friction 0.5 two steps above 1 mJ, up to 4.3 mJ of
+/// 3.4e4 J; `docs/stepped.md`).
+const SPARSE_REHOLD_FRICTION_ROUNDS: usize = 16;
 
 /// A body of a stack: a free ball or a cluster, restarted at the hold's instant.
 struct Part<T: Real, const D: usize>
@@ -1705,10 +1717,10 @@ where
             again = stack.approach == Approach::Resting;
         };
         let mut settled = friction <= T::zero();
-        let most_rounds = if sparse {
-            SPARSE_FRICTION_ROUNDS
-        } else {
-            FRICTION_ROUNDS
+        let most_rounds = match (sparse, stack.s > T::zero()) {
+            (true, true) => SPARSE_REHOLD_FRICTION_ROUNDS,
+            (true, false) => SPARSE_FRICTION_ROUNDS,
+            (false, _) => FRICTION_ROUNDS,
         };
         for _ in 0..most_rounds {
             normal(self, &mut lambda, &tangential);
