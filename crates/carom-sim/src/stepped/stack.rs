@@ -147,9 +147,9 @@ const SPARSE_FRICTION_ROUNDS: usize = 128;
 
 /// The rounds of a hold solved sparsely within the step (`s > 0`: after a contact of
 /// one of its balls, a pile held again), which start from the forces the same rows took
-/// in the step's earlier holds (`Warm`): friction goes on converging from hold to hold,
+/// last (`Warm`, where they have any): friction goes on converging from hold to hold,
 /// and the next step's first hold runs all [`SPARSE_FRICTION_ROUNDS`]. While the
-/// 480-ball pile lands it is held again some 20 to 130 times a step, and with 128
+/// 480-ball pile lands it is held again 18 to 131 times a step (steps 40–60), and with 128
 /// rounds each such hold ran nearly all of them: its 300 steps took 336 s, 129 s with
 /// 16 (the landing 309 s and 99 s). What it costs: friction that has not converged
 /// adds a little energy now and then (the largest rise in a step 2.1e-4 J against
