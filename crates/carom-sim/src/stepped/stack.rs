@@ -154,7 +154,8 @@ const SPARSE_FRICTION_ROUNDS: usize = 128;
 /// 16 (the landing 309 s and 99 s). What it costs: friction that has not converged
 /// adds a little energy now and then (the largest rise in a step 2.1e-4 J against
 /// 1.2e-4 J, in a variant with friction 0.5 two steps above 1 mJ, up to 4.3 mJ of
-/// 3.4e4 J; `docs/stepped.md`).
+/// 3.4e4 J; none above 1 mJ there since `Warm` keeps forces over at least half a step;
+/// `docs/stepped.md`).
 const SPARSE_REHOLD_FRICTION_ROUNDS: usize = 16;
 
 /// A body of a stack: a free ball or a cluster, restarted at the hold's instant.
@@ -1750,7 +1751,10 @@ where
         }
         if warm {
             let rows = rows.iter().map(|&c| &stack.rows[c]);
-            self.solvers.warm.keep(rows, rest, &lambda, &tangential);
+            let step = self.h.to_f64();
+            self.solvers
+                .warm
+                .keep(rows, (rest, step), &lambda, &tangential);
         }
         (rows.iter().zip(lambda.iter().zip(&tangential)))
             .map(|(&c, (&l, t))| t - wide(&stack.rows[c].normal) * l)
