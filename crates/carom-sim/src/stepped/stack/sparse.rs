@@ -36,11 +36,12 @@ type RowKey = (u32, u8, u32);
 /// Why not less than half a step: a hold `τ` before the step's end that stops a chord
 /// closing at `u` gives an impulse of about `m u` whatever `τ`, and kept over `τ` alone
 /// it made the next step start from `m u h / τ`. In a landing pile (`restitution =
-/// 0.35`) such a start reached 6.5e7 N s of friction, which the sparse solve's proximal
-/// rounds keep along directions nothing moves in, and one step spun the pile up by
-/// 1e7 J (`docs/stepped.md`, piles items 12 and 13). Over at least half a step, a start
-/// is at most twice the impulse a hold gave; holds over more (every step's first) keep
-/// their forces as they were.
+/// 0.35`) a step's first hold started from 6.5e7 N s of friction and that step spun the
+/// pile up by 1e7 J (`docs/stepped.md`, piles items 12 and 13; that the start came from
+/// a late hold is reasoned, not printed hold by hold, and with forces kept over at least
+/// half a step the same run ended at 36,897 J). Over at least half a step, a start is at
+/// most twice the impulse a hold gave; holds over more (every hold at a step's start)
+/// keep their forces as they were.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Warm<const D: usize> {
     /// Found in this step.
