@@ -573,16 +573,20 @@ fn a_packed_pyramid_too_large_for_the_exact_solver_stays_put() {
 /// allows (a contact closing slower than a millionth of `g h` sinks for the rest of the
 /// step: 2.7e-9 m, plus both balls' touch tolerance, 2.7e-10 m each), and the energy
 /// (kinetic and potential) never above the last step's beyond what that allowance
-/// lets the pile's weight do (every ball lifted by it: `M g` times 2.7e-9 m, 3.2e-6 J)
-/// and [`FRICTION_RISE`] of itself; after 4 s the pile is at rest: every ball slower
-/// than 1 mm/s but one rolling freely on the floor ([`pile_speed`]), and none faster a
-/// second later beyond the speed the narrow phase takes for resting (a millionth of
-/// `g h`). (A pile whose friction is too weak creeps: with its friction rounds started
-/// from nothing at every hold, a ball slid down this pile at 9.6 mm/s at 4 s, 11 mm/s
-/// at 4.5 s and 0.18 m/s at 8 s.)
+/// lets the pile's weight do (every ball lifted by it: `M g` times 2.7e-9 m, 3.2e-6 J);
+/// after 4 s the pile is at rest: every ball slower than 1 mm/s but one rolling freely
+/// on the floor ([`pile_speed`]), and it does not creep ([`drop_rows_of_balls`]).
+/// (A pile whose friction is too weak creeps: with its friction rounds started from
+/// nothing at every hold, a ball slid down this pile at 9.6 mm/s at 4 s, 11 mm/s at
+/// 4.5 s and 0.18 m/s at 8 s.)
+///
+/// The energy bound held for 18 draws of the rows (this one and 17 other seeds of its
+/// generator, in a scratch copy) once a pile's exact holds ran 128 over-relaxed
+/// friction rounds; with 32 plain rounds, 17 of them rose beyond it, by up to 298 times
+/// it (`docs/stepped.md`, piles items 13 and 14).
 #[test]
 fn a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest() {
-    let largest = drop_rows_of_balls(6);
+    let largest = drop_rows_of_balls(6, 0.0);
     assert!(largest > 64, "the largest hold took {largest} contacts");
 }
 
@@ -592,28 +596,21 @@ fn a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest() {
 /// after each contact of two of its balls that the pile cannot take as a surface, each
 /// of those with up to 16 rounds started from the forces of the holds before (377 such
 /// holds in its 300 steps, counted with a print; the 96-ball pile has none). The same
-/// bounds hold every step.
+/// bounds hold every step, the energy's with [`SPARSE_FRICTION_RISE`] more.
 #[test]
 fn a_pile_held_in_sparse_holds_lands_apart_inside_and_comes_to_rest() {
-    let largest = drop_rows_of_balls(12);
+    let largest = drop_rows_of_balls(12, SPARSE_FRICTION_RISE);
     assert!(largest > 256, "the largest hold took {largest} contacts");
 }
 
-/// How much of the pile's energy a step of the pile tests above may gain beyond what
-/// the narrow phase's allowance lets its weight do. Friction's rounds end unconverged
-/// when they run out (a sparse solve ends within a tolerance too), and friction not yet
-/// converged may do work. Held to the allowance alone, the 96-ball pile's energy
-/// rises beyond it or not by the rounding of a division: its largest rise was 0.72 of
-/// the allowance with the kept forces divided by the time they acted over, and 2.7
-/// times it (8.7e-6 J, step 220) multiplied by its reciprocal. With 8 other draws of
-/// its rows, the code of the thirty-sixth session rose beyond it in 6, by up to 147
-/// times (4.7e-4 J, 3.3e-7 of the pile's energy, within a hold at a step's start that
-/// lifted balls of the settled pile at millimetres a second), and the code after it in
-/// 6 of 8, by up to 51 times (1.6e-4 J, 1.1e-7 of the energy): an open defect
-/// (`docs/stepped.md`, piles item 13), which this bound covers for the draw tested
-/// and not for every draw. The 192-ball pile, held to the allowance alone (6.4e-6 J),
-/// rose by 8.4e-5 J at step 284 in that session.
-const FRICTION_RISE: f64 = 1e-7;
+/// How much of its energy the sparsely held pile may gain in a step beyond what the
+/// narrow phase's allowance lets its weight do. A sparse solve ends within a
+/// tolerance, and its friction rounds (up to 128 at a step's start, 16 in a hold within
+/// the step) end unconverged when they run out: friction not yet converged may do
+/// work. Held to the allowance alone (6.4e-6 J), this pile rose by 8.4e-5 J at step 284
+/// in the thirty-sixth session; in the thirty-eighth, over its draw and 5 others, by
+/// up to 4.5 times the allowance (5.0e-9 of its energy).
+const SPARSE_FRICTION_RISE: f64 = 1e-7;
 
 /// The fastest of `states`' balls but those rolling freely on the floor of `scene`'s
 /// border: touching no other ball and neither wall (none closer than 1e-6 m), moving
@@ -642,9 +639,18 @@ fn pile_speed(scene: &Scene<f64, 2>, states: &BallStates<f64, 2>) -> f64 {
 }
 
 /// Drops `rows` rows of 16 balls as the tests above describe, checks every step's
-/// bounds (the energy allowed to rise by [`FRICTION_RISE`] of itself more than the
-/// narrow phase allows), and returns the largest hold's contacts.
-fn drop_rows_of_balls(rows: u32) -> u64 {
+/// bounds (the energy allowed to rise by `friction_rise` of itself more than the narrow
+/// phase allows), and returns the largest hold's contacts.
+///
+/// The pile does not creep: the slowest its fastest ball gets in the quarter second
+/// before 5 s is no faster than in the quarter second before 4 s, beyond the speed the
+/// narrow phase takes for resting (a millionth of `g h`). A creep is sustained; a
+/// settled pile may also slip at one contact now and then, briefly, releasing energy:
+/// the 192-ball pile, at 1e-9 m/s from 4 s on, slipped at step 298 (a ball on two
+/// others moving up to 3.7e-5 m/s, the pile's energy falling by 2.3e-4 J) and again
+/// near 6 s and 7.5 s (2e-6 m/s), each over within a quarter second (a scratch run to
+/// 10 s), which its speed at 5 s alone took for a creep.
+fn drop_rows_of_balls(rows: u32, friction_rise: f64) -> u64 {
     let mut seed = 0x2545_f491_4f6c_dd1d_u64;
     let mut uniform = move || {
         seed ^= seed << 13;
@@ -679,13 +685,21 @@ fn drop_rows_of_balls(rows: u32) -> u64 {
     let weight: f64 = s.balls.iter().map(|b| b.mass * G).sum();
     let mut sim = stepped(&s, Integrator::SemiImplicitEuler, dt);
     let mut before = observe::energy(&s, &states(&sim));
-    let mut at_rest = f64::INFINITY;
+    // The slowest the pile's fastest ball gets in the quarter second before 4 s and
+    // before 5 s.
+    let (mut at_rest, mut later) = (f64::INFINITY, f64::INFINITY);
     for k in 1..=300 {
         sim.advance_to(f64::from(k) * dt, &mut ()).unwrap();
         let st = states(&sim);
-        if k == 240 {
-            at_rest = pile_speed(&s, &st);
-            assert!(at_rest < 1e-3, "a ball still moves at {at_rest} m/s at 4 s");
+        if (226..=240).contains(&k) {
+            let speed = pile_speed(&s, &st);
+            at_rest = at_rest.min(speed);
+            if k == 240 {
+                assert!(speed < 1e-3, "a ball still moves at {speed} m/s at 4 s");
+            }
+        }
+        if (286..=300).contains(&k) {
+            later = later.min(pile_speed(&s, &st));
         }
         let (outside, overlap) = (outside_border(&s, &st), deepest_overlap(&s, &st));
         assert!(outside <= 1e-9, "step {k}: a ball {outside:e} m outside");
@@ -695,15 +709,14 @@ fn drop_rows_of_balls(rows: u32) -> u64 {
         );
         let e = observe::energy(&s, &st);
         assert!(
-            e <= before + weight * sink + FRICTION_RISE * before,
+            e <= before + weight * sink + friction_rise * before,
             "step {k}: energy {before} -> {e}"
         );
         before = e;
     }
-    let later = pile_speed(&s, &states(&sim));
     assert!(
         later <= (at_rest * (1.0 + 1e-6)).max(resting),
-        "the pile creeps: its fastest ball went from {at_rest} m/s at 4 s to {later} at 5 s"
+        "the pile creeps: its fastest ball was at least {at_rest} m/s in the quarter second before 4 s and {later} before 5 s"
     );
     sim.stats().largest_hold
 }
