@@ -595,7 +595,8 @@ fn a_pile_of_dropped_balls_lands_apart_inside_and_comes_to_rest() {
 /// solved sparsely: at each step's start with up to 128 friction rounds, and again
 /// after each contact of two of its balls that the pile cannot take as a surface, each
 /// of those with up to 16 rounds started from the forces of the holds before (377 such
-/// holds in its 300 steps, counted with a print; the 96-ball pile has none). The same
+/// holds in its 300 steps, counted with a print in the thirty-sixth session; the 96-ball
+/// pile has none). The same
 /// bounds hold every step, the energy's with [`SPARSE_FRICTION_RISE`] more.
 #[test]
 fn a_pile_held_in_sparse_holds_lands_apart_inside_and_comes_to_rest() {
@@ -616,7 +617,7 @@ const SPARSE_FRICTION_RISE: f64 = 1e-7;
 /// border: touching no other ball and neither wall (none closer than 1e-6 m), moving
 /// along the floor and rolling on it without slipping. Nothing slows such a ball (no
 /// rolling resistance is modelled), so a pile at rest may have sent one off: the 96-ball
-/// pile sends one off at 0.93 mm/s.
+/// pile sent one off at 0.93 mm/s with the code of the thirty-seventh session.
 fn pile_speed(scene: &Scene<f64, 2>, states: &BallStates<f64, 2>) -> f64 {
     let border = scene.world.border.as_ref().expect("a border").border;
     let (low, high) = (border.min(), border.max());
@@ -648,8 +649,9 @@ fn pile_speed(scene: &Scene<f64, 2>, states: &BallStates<f64, 2>) -> f64 {
 /// settled pile may also slip at one contact now and then, briefly, releasing energy:
 /// the 192-ball pile, at 1e-9 m/s from 4 s on, slipped at step 298 (a ball on two
 /// others moving up to 3.7e-5 m/s, the pile's energy falling by 2.3e-4 J) and again
-/// near 6 s and 7.5 s (2e-6 m/s), each over within a quarter second (a scratch run to
-/// 10 s), which its speed at 5 s alone took for a creep.
+/// near 6 s (2.1e-6 m/s) and 7.5 s (1.6e-7 m/s), each back below the resting speed
+/// within a quarter second (a scratch run to 10 s, read every 15 steps), which its
+/// speed at 5 s alone took for a creep.
 fn drop_rows_of_balls(rows: u32, friction_rise: f64) -> u64 {
     let mut seed = 0x2545_f491_4f6c_dd1d_u64;
     let mut uniform = move || {

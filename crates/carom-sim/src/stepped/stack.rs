@@ -140,9 +140,10 @@ const FRICTION_ROUNDS: usize = 32;
 /// the pile's weight do in 17 draws with 32 plain rounds (beyond it by up to 298 times
 /// it, 6.5e-7 of the pile's energy), in 1 with 512 plain rounds (by a tenth of it; a
 /// median 4.2 times the time) and in none with these (1.4 times the time; the 480-ball
-/// pile's slowest landing step 10.8 s against 4.9 s, its total 10 % more). Even with
-/// 512 rounds a third of the holds end unsettled: more rounds narrow what friction
-/// leaves undone, they do not remove it (`docs/stepped.md`, piles item 14).
+/// pile's slowest landing step 10.8 s against 4.9 s, its 5 s 2 to 10 % longer). In the
+/// test's own draw a third of the holds still end unsettled with 512 rounds, plain or
+/// over-relaxed: more rounds narrow what friction leaves undone, they do not remove it
+/// (`docs/stepped.md`, piles item 14).
 const PILE_FRICTION_ROUNDS: usize = 128;
 
 /// The over-relaxation `ω` of the friction sweeps of [`PILE_FRICTION_ROUNDS`]: each
@@ -151,10 +152,10 @@ const PILE_FRICTION_ROUNDS: usize = 128;
 /// projected Gauss–Seidel on a convex quadratic programme (the contacts' kinetic energy
 /// over the product of the rows' cones), on which projected successive over-relaxation
 /// converges for any `0 < ω < 2` (Cryer 1971, for bounds: a 2D row's cone; in 3D the
-/// step along the slip is a line search, not the row's exact minimum). With 32 rounds, the 96-ball drop's draws with a
-/// step above the allowance: 17 of 18 plain (beyond it by up to 298 times it), 8 of 18
-/// at 1.8 (up to 42 times), 3 of 9 at 1.5 and 6 of 9 at 1.9 (up to 6 and 32 times);
-/// with 128 plain rounds 1 of 9 (15 times).
+/// step along the slip is a line search, not the row's exact minimum). With 32 rounds,
+/// the 96-ball drop's draws with a step above the allowance: 17 of 18 plain (beyond it
+/// by up to 298 times it), 8 of 18 at 1.8 (up to 42 times), 3 of 9 at 1.5 and 6 of 9
+/// at 1.9 (up to 6 and 32 times); with 128 plain rounds 1 of 9 (15 times).
 const PILE_OVER_RELAXATION: f64 = 1.8;
 
 /// Rounds of normal and tangential impulses in turn in a hold solved sparsely (above
@@ -1712,7 +1713,8 @@ where
         // goes on converging from where the last hold left it instead of starting
         // from no friction each time (see `stack::Warm`).
         let sparse = matches!(a, Delassus::Sparse(_));
-        let warm = warm && (sparse || stack.approach == Approach::Resting) && rest > 0.0;
+        let pile = stack.approach == Approach::Resting;
+        let warm = warm && (sparse || pile) && rest > 0.0;
         if warm {
             let rows = rows.iter().map(|&c| &stack.rows[c]);
             (self.solvers.warm).start(
@@ -1744,10 +1746,9 @@ where
             this.solvers.solve(&a, &q, tolerance, lambda, again);
             // A pile's friction rounds solve again from the last round's passive set;
             // other holds from scratch (their numbers as before `resolve` existed).
-            again = stack.approach == Approach::Resting;
+            again = pile;
         };
         let mut settled = friction <= T::zero();
-        let pile = stack.approach == Approach::Resting;
         let (most_rounds, relaxation) = match (sparse, stack.s > T::zero()) {
             (true, true) => (SPARSE_REHOLD_FRICTION_ROUNDS, 1.0),
             (true, false) => (SPARSE_FRICTION_ROUNDS, 1.0),
