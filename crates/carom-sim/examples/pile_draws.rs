@@ -1,0 +1,173 @@
+//! The pile test's drop (`tests/stepped_resting.rs`, `drop_rows_of_balls`) over many
+//! draws of its generator: for each seed, 300 steps of rows of 16 balls dropped into a
+//! box 10 m wide (restitution 0.2, friction 0.3, semi-implicit Euler, `dt = 1/60`), the
+//! steps whose energy rose beyond what the narrow phase's allowance lets the pile's
+//! weight do, the largest such rise (in allowances and as a fraction of the energy),
+//! the fastest ball at 4 s and the run's wall time.
+//!
+//! ```sh
+//! cargo run --release -p carom-sim --example pile_draws -- [ROWS] [SEEDS] [FIRST] [DIM]
+//! cargo run --release -p carom-sim --example pile_draws -- 6 18
+//! ```
+//!
+//! Seed 0 is the test's own draw; seeds `k > 0` start its xorshift generator from
+//! `0x2545_f491_4f6c_dd1d + k`. `DIM` 3 drops the balls in square layers of 4×4 into a
+//! box 2.5 m wide instead (64 balls for 4 layers), the 3D check of `docs/stepped.md`.
+
+use std::time::Instant;
+
+use carom_geometry::Border;
+use carom_integrate::Integrator;
+use carom_math::{Space, Vector};
+use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};
+use carom_sim::scene::{BallSpec, BorderSpec, Scene, World};
+use carom_sim::stepped::SteppedEngine;
+use carom_sim::{BallStates, Simulation, observe};
+use carom_toi::Direction;
+use nalgebra::Const;
+
+const G: f64 = 9.81;
+
+fn arg<T: std::str::FromStr>(k: usize, default: T) -> T {
+    std::env::args().nth(k).map_or(default, |s| {
+        s.parse()
+            .unwrap_or_else(|_| panic!("argument {k}: cannot parse `{s}`"))
+    })
+}
+
+/// The test's generator: xorshift64 from `seed`, uniform in `[0, 1)`.
+fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed;
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1_u64 << 53) as f64
+    }
+}
+
+/// `rows` rows (2D) or layers (3D) of balls drawn from `seed`, in the test's box.
+fn scene<const D: usize>(rows: u32, seed: u64) -> Scene<f64, D> {
+    let mut next = uniform(seed);
+    let (per_row, width) = if D == 2 { (16, 10.0) } else { (16, 2.5) };
+    let mut balls = Vec::new();
+    for row in 0..rows {
+        for k in 0..per_row {
+            let mut pos = Vector::<f64, D>::zeros();
+            let mut vel = Vector::<f64, D>::zeros();
+            if D == 2 {
+                pos[0] = -4.7 + 0.625 * f64::from(k) + 0.1 * (next() - 0.5);
+                vel[0] = 2.0 * next() - 1.0;
+            } else {
+                pos[0] = -0.9 + 0.6 * f64::from(k % 4) + 0.1 * (next() - 0.5);
+                pos[2] = -0.9 + 0.6 * f64::from(k / 4) + 0.1 * (next() - 0.5);
+                vel[0] = 2.0 * next() - 1.0;
+                vel[2] = 2.0 * next() - 1.0;
+            }
+            pos[1] = 0.5 + 0.6 * f64::from(row);
+            balls.push(BallSpec::new(pos, vel, 0.25, 0.5 + 1.5 * next()));
+        }
+    }
+    let mut gravity = Vector::<f64, D>::zeros();
+    gravity[1] = -G;
+    let mut low = Vector::<f64, D>::repeat(-width / 2.0);
+    let mut high = Vector::<f64, D>::repeat(width / 2.0);
+    low[1] = 0.0;
+    high[1] = 30.0;
+    Scene {
+        world: World {
+            gravity,
+            restitution: 0.2,
+            friction: 0.3,
+            border: Some(BorderSpec {
+                border: Border::new(low, high).expect("a valid border"),
+                restitution: 0.2,
+                periodic: false,
+            }),
+            ..World::default()
+        },
+        balls,
+        ..Scene::default()
+    }
+}
+
+fn states<const D: usize>(sim: &dyn Simulation<f64, D>) -> BallStates<f64, D>
+where
+    Const<D>: Space<f64, D>,
+{
+    let mut st = BallStates::default();
+    sim.states(&mut st);
+    st
+}
+
+/// One draw: (steps above the allowance, largest rise in allowances, as a fraction of
+/// the energy, fastest ball at 4 s, wall seconds).
+fn draw<const D: usize>(rows: u32, seed: u64) -> (usize, f64, f64, f64, f64)
+where
+    Const<D>: Space<f64, D>,
+{
+    let s = scene::<D>(rows, seed);
+    let dt = 1.0 / 60.0;
+    let options = RunOptions {
+        engine: EngineChoice::Stepped,
+        integrator: Some(Integrator::SemiImplicitEuler),
+        dt: Some(dt),
+        broad: BroadChoice::Auto,
+    };
+    let p = plan(&s, &options).expect("a valid plan");
+    let mut sim = SteppedEngine::new(&s, &p, Direction::Forward).expect("a valid scene");
+    let sink = 1e-6 * G * dt * dt;
+    let weight: f64 = s.balls.iter().map(|b| b.mass * G).sum();
+    let allowance = weight * sink;
+    let mut before = observe::energy(&s, &states(&sim));
+    let (mut above, mut worst, mut fraction, mut at_4) = (0, 0.0_f64, 0.0_f64, 0.0);
+    let start = Instant::now();
+    for k in 1..=300 {
+        sim.advance_to(f64::from(k) * dt, &mut ())
+            .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let st = states(&sim);
+        let e = observe::energy(&s, &st);
+        let rise = e - before;
+        if rise > allowance {
+            above += 1;
+            if rise / allowance > worst {
+                worst = rise / allowance;
+                fraction = rise / before;
+            }
+        }
+        if k == 240 {
+            at_4 = st.vel.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        }
+        before = e;
+    }
+    (above, worst, fraction, at_4, start.elapsed().as_secs_f64())
+}
+
+fn main() {
+    let (rows, seeds, first, dim) = (
+        arg(1, 6_u32),
+        arg(2, 18_u64),
+        arg(3, 0_u64),
+        arg(4, 2_usize),
+    );
+    let mut times = Vec::new();
+    let mut draws_above = 0;
+    for k in first..first + seeds {
+        let seed = 0x2545_f491_4f6c_dd1d_u64 + k;
+        let (above, worst, fraction, at_4, wall) = match dim {
+            2 => draw::<2>(rows, seed),
+            3 => draw::<3>(rows, seed),
+            other => panic!("argument 4: dimension {other} is not 2 or 3"),
+        };
+        draws_above += usize::from(above > 0);
+        times.push(wall);
+        println!(
+            "seed {k:>3}: {above:>3} steps above the allowance, largest {worst:>9.2}x ({fraction:.1e} of the energy); fastest at 4 s {at_4:.2e} m/s; {wall:.2} s"
+        );
+    }
+    times.sort_by(f64::total_cmp);
+    println!(
+        "{draws_above} of {seeds} draws above the allowance; median run {:.2} s",
+        times[times.len() / 2]
+    );
+}
