@@ -10,85 +10,26 @@
 //! cargo run --release -p carom-sim --example pile_draws -- 6 18
 //! ```
 //!
-//! Seed 0 is the test's own draw; seeds `k > 0` start its xorshift generator from
-//! `0x2545_f491_4f6c_dd1d + k`. `DIM` 3 drops the balls in square layers of 4×4 into a
-//! box 2.5 m wide instead (64 balls for 4 layers), the 3D check of `docs/stepped.md`.
+//! The scenes are `carom_sim::scenes::pile::dropped_rows` (seed 0 is the test's own
+//! draw). `DIM` 3 drops the balls in square layers of 4×4 into a box 2.5 m wide instead
+//! (64 balls for 4 layers), the 3D check of `docs/stepped.md`.
 
 use std::time::Instant;
 
-use carom_geometry::Border;
 use carom_integrate::Integrator;
-use carom_math::{Space, Vector};
+use carom_math::Space;
 use carom_sim::plan::{BroadChoice, EngineChoice, RunOptions, plan};
-use carom_sim::scene::{BallSpec, BorderSpec, Scene, World};
+use carom_sim::scenes::pile;
 use carom_sim::stepped::SteppedEngine;
 use carom_sim::{BallStates, Simulation, observe};
 use carom_toi::Direction;
 use nalgebra::Const;
-
-const G: f64 = 9.81;
 
 fn arg<T: std::str::FromStr>(k: usize, default: T) -> T {
     std::env::args().nth(k).map_or(default, |s| {
         s.parse()
             .unwrap_or_else(|_| panic!("argument {k}: cannot parse `{s}`"))
     })
-}
-
-/// The test's generator: xorshift64 from `seed`, uniform in `[0, 1)`.
-fn uniform(seed: u64) -> impl FnMut() -> f64 {
-    let mut s = seed;
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1_u64 << 53) as f64
-    }
-}
-
-/// `rows` rows (2D) or layers (3D) of balls drawn from `seed`, in the test's box.
-fn scene<const D: usize>(rows: u32, seed: u64) -> Scene<f64, D> {
-    let mut next = uniform(seed);
-    let (per_row, width) = if D == 2 { (16, 10.0) } else { (16, 2.5) };
-    let mut balls = Vec::new();
-    for row in 0..rows {
-        for k in 0..per_row {
-            let mut pos = Vector::<f64, D>::zeros();
-            let mut vel = Vector::<f64, D>::zeros();
-            if D == 2 {
-                pos[0] = -4.7 + 0.625 * f64::from(k) + 0.1 * (next() - 0.5);
-                vel[0] = 2.0 * next() - 1.0;
-            } else {
-                pos[0] = -0.9 + 0.6 * f64::from(k % 4) + 0.1 * (next() - 0.5);
-                pos[2] = -0.9 + 0.6 * f64::from(k / 4) + 0.1 * (next() - 0.5);
-                vel[0] = 2.0 * next() - 1.0;
-                vel[2] = 2.0 * next() - 1.0;
-            }
-            pos[1] = 0.5 + 0.6 * f64::from(row);
-            balls.push(BallSpec::new(pos, vel, 0.25, 0.5 + 1.5 * next()));
-        }
-    }
-    let mut gravity = Vector::<f64, D>::zeros();
-    gravity[1] = -G;
-    let mut low = Vector::<f64, D>::repeat(-width / 2.0);
-    let mut high = Vector::<f64, D>::repeat(width / 2.0);
-    low[1] = 0.0;
-    high[1] = 30.0;
-    Scene {
-        world: World {
-            gravity,
-            restitution: 0.2,
-            friction: 0.3,
-            border: Some(BorderSpec {
-                border: Border::new(low, high).expect("a valid border"),
-                restitution: 0.2,
-                periodic: false,
-            }),
-            ..World::default()
-        },
-        balls,
-        ..Scene::default()
-    }
 }
 
 fn states<const D: usize>(sim: &dyn Simulation<f64, D>) -> BallStates<f64, D>
@@ -106,7 +47,7 @@ fn draw<const D: usize>(rows: u32, seed: u64) -> (usize, f64, f64, f64, f64)
 where
     Const<D>: Space<f64, D>,
 {
-    let s = scene::<D>(rows, seed);
+    let s = pile::dropped_rows::<D>(rows, seed);
     let dt = 1.0 / 60.0;
     let options = RunOptions {
         engine: EngineChoice::Stepped,
@@ -116,9 +57,7 @@ where
     };
     let p = plan(&s, &options).expect("a valid plan");
     let mut sim = SteppedEngine::new(&s, &p, Direction::Forward).expect("a valid scene");
-    let sink = 1e-6 * G * dt * dt;
-    let weight: f64 = s.balls.iter().map(|b| b.mass * G).sum();
-    let allowance = weight * sink;
+    let allowance = pile::allowance(&s, dt);
     let mut before = observe::energy(&s, &states(&sim));
     let (mut above, mut worst, mut fraction, mut at_4) = (0, 0.0_f64, 0.0_f64, 0.0);
     let start = Instant::now();
@@ -136,7 +75,11 @@ where
             }
         }
         if k == 240 {
-            at_4 = st.vel.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            at_4 = st
+                .vel
+                .iter()
+                .map(nalgebra::Matrix::norm)
+                .fold(0.0, f64::max);
         }
         before = e;
     }
@@ -153,10 +96,9 @@ fn main() {
     let mut times = Vec::new();
     let mut draws_above = 0;
     for k in first..first + seeds {
-        let seed = 0x2545_f491_4f6c_dd1d_u64 + k;
         let (above, worst, fraction, at_4, wall) = match dim {
-            2 => draw::<2>(rows, seed),
-            3 => draw::<3>(rows, seed),
+            2 => draw::<2>(rows, k),
+            3 => draw::<3>(rows, k),
             other => panic!("argument 4: dimension {other} is not 2 or 3"),
         };
         draws_above += usize::from(above > 0);

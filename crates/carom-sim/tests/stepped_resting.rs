@@ -581,7 +581,7 @@ fn a_packed_pyramid_too_large_for_the_exact_solver_stays_put() {
 /// 4.5 s and 0.18 m/s at 8 s.)
 ///
 /// The energy bound held for 18 draws of the rows (this one and 17 other seeds of its
-/// generator, in a scratch copy) once a pile's exact holds ran 128 over-relaxed
+/// generator: `examples/pile_draws.rs`) once a pile's exact holds ran 128 over-relaxed
 /// friction rounds; with 32 plain rounds, 17 of them rose beyond it, by up to 298 times
 /// it (`docs/stepped.md`, piles items 13 and 14).
 #[test]
@@ -653,30 +653,7 @@ fn pile_speed(scene: &Scene<f64, 2>, states: &BallStates<f64, 2>) -> f64 {
 /// within a quarter second (a scratch run to 10 s, read every 15 steps), which its
 /// speed at 5 s alone took for a creep.
 fn drop_rows_of_balls(rows: u32, friction_rise: f64) -> u64 {
-    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-    let mut uniform = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1_u64 << 53) as f64
-    };
-    let mut balls = Vec::new();
-    for row in 0..rows {
-        for k in 0..16 {
-            let x = -4.7 + 0.625 * f64::from(k) + 0.1 * (uniform() - 0.5);
-            let vel = Vector2::new(2.0 * uniform() - 1.0, 0.0);
-            let pos = Vector2::new(x, 0.5 + 0.6 * f64::from(row));
-            balls.push(BallSpec::new(pos, vel, 0.25, 0.5 + 1.5 * uniform()));
-        }
-    }
-    let mut world = floor_world(0.2, 0.3, 10.0);
-    world.border.as_mut().unwrap().border =
-        Border::new(Vector2::new(-5.0, 0.0), Vector2::new(5.0, 30.0)).unwrap();
-    let s = Scene {
-        world,
-        balls,
-        ..Scene::default()
-    };
+    let s = carom_sim::scenes::pile::dropped_rows::<2>(rows, 0);
     let dt = 1.0 / 60.0;
     let touch = 1e-9 * 0.25 + 16.0 * f64::EPSILON * (5.0 + 0.25);
     // The speed below which the narrow phase takes a contact for resting, and how far

@@ -8,11 +8,14 @@
 //!   collisions, Newton's cradle, a dropped ball).
 //! * [`fuzz`]: random scenes of every kind the scene format allows, drawn from a seed,
 //!   and the invariants a run of one must keep (robustness campaigns).
+//! * [`pile`]: rows of balls dropped into a narrow box under gravity with friction, where
+//!   they form a pile (the stepped engine's pile test and its draws over seeds).
 
 pub mod classic;
 pub mod collision_lab;
 pub mod fuzz;
 pub mod gas;
+pub mod pile;
 
 /// The deterministic random generator of every shared scene: carom-broad's SplitMix64,
 /// so scenes built from a seed are identical on every machine and in every version,
