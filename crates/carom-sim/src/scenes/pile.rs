@@ -19,7 +19,7 @@ const FIRST_STATE: u64 = 0x2545_f491_4f6c_dd1d;
 /// (restitution 0.2 for balls and walls, friction 0.3), drawn from `draw` (0: the pile
 /// test's own). In 2D the box is 10 m wide and a row is a line 0.625 m apart; in 3D it is
 /// 2.5 m wide and deep, and a row is a square of 4 × 4 balls 0.6 m apart. Each ball's
-/// place is jittered by up to 5 cm along the row.
+/// place is jittered by up to 5 cm along each horizontal axis.
 ///
 /// The numbers come from xorshift64 (Marsaglia's 13/7/17), the generator the pile test
 /// was written with, so that draw 0 is its scene bit for bit.
@@ -79,7 +79,13 @@ pub fn dropped_rows<const D: usize>(rows: u32, draw: u64) -> Scene<f64, D> {
 pub fn allowance<T: Real, const D: usize>(scene: &Scene<T, D>, dt: f64) -> f64 {
     let g = scene.world.gravity.norm().to_f64();
     let weight: f64 = scene.balls.iter().map(|b| b.mass.to_f64() * g).sum();
-    weight * 1e-6 * g * dt * dt
+    weight * (resting_speed(g, dt) * dt)
+}
+
+/// The speed below which the narrow phase takes a contact for resting under gravity
+/// `g` with steps of `dt`: a millionth of `g dt`.
+pub fn resting_speed(g: f64, dt: f64) -> f64 {
+    1e-6 * g * dt
 }
 
 #[cfg(test)]
