@@ -191,6 +191,18 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         }
     }
 
+    /// Appends every ball in the cells around ball `i`'s, `i` included, to `out`, in the
+    /// order of [`Self::for_each_near`], copying whole rows (`IdRows::append_to`: no
+    /// branch on a cell's length).
+    #[inline]
+    pub(crate) fn gather_near(&self, i: usize, out: &mut Vec<u32>) {
+        let mut around = [0; MAX_AROUND];
+        let count = self.around(i, &mut around);
+        for &c in &around[..count] {
+            self.members.append_to(c, out);
+        }
+    }
+
     /// Asks for ball `i`'s cell and times to be brought into the cache.
     #[inline]
     pub(crate) fn prefetch_place(&self, i: usize) {
@@ -307,20 +319,14 @@ impl<T: Real, const D: usize> CellLists<T, D> {
         self.places[i].cell = to.map(|x| x as i32);
     }
 
-    /// Calls `f` with every ball in the cells that ball `i`'s neighbourhood gained when it
+    /// Appends to `out` every ball in the cells that ball `i`'s neighbourhood gained when it
     /// crossed the face (`axis`, `upper`) into its cell: the row of `3^(D−1)` cells one
-    /// further along `axis`.
-    pub(crate) fn for_each_entering(
-        &self,
-        i: usize,
-        axis: usize,
-        upper: bool,
-        mut f: impl FnMut(usize),
-    ) {
+    /// further along `axis`. Whole rows are copied (`IdRows::append_to`).
+    pub(crate) fn gather_entering(&self, i: usize, axis: usize, upper: bool, out: &mut Vec<u32>) {
         let mut slab = [0usize; MAX_AROUND];
         let count = self.grid.slab(self.cell(i), axis, upper, &mut slab);
         for &c in &slab[..count] {
-            self.members.of(c).for_each(|j| f(j as usize));
+            self.members.append_to(c, out);
         }
     }
 
@@ -374,11 +380,18 @@ mod tests {
     use nalgebra::{Vector2, Vector3};
     use std::collections::BTreeSet;
 
+    /// The balls near `i`, each met once, gathered as visited and in the same order.
     fn near<const D: usize>(cells: &CellLists<f64, D>, i: usize) -> BTreeSet<usize> {
         let mut s = BTreeSet::new();
+        let mut visited = Vec::new();
         cells.for_each_near(i, |j| {
             assert!(s.insert(j), "ball {j} met twice");
+            visited.push(j as u32);
         });
+        let mut gathered = vec![u32::MAX];
+        cells.gather_near(i, &mut gathered);
+        assert_eq!(gathered[0], u32::MAX, "appended after what was there");
+        assert_eq!(gathered[1..], visited[..], "gathered as visited");
         s
     }
 
@@ -422,10 +435,10 @@ mod tests {
                 );
             }
             let after = near(&cells, 0);
-            let mut entering = BTreeSet::new();
-            cells.for_each_entering(0, c.axis as usize, c.upper, |j| {
-                entering.insert(j);
-            });
+            let mut gathered = Vec::new();
+            cells.gather_entering(0, c.axis as usize, c.upper, &mut gathered);
+            let entering: BTreeSet<usize> = gathered.iter().map(|&j| j as usize).collect();
+            assert_eq!(entering.len(), gathered.len(), "a ball gathered twice");
             if counts >= 3 {
                 let gained: BTreeSet<usize> = after.difference(&before).copied().collect();
                 assert_eq!(entering, gained, "crossing {crossings}");

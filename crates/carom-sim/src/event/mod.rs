@@ -241,6 +241,9 @@ where
     /// The size of the scene, for the tolerance of cluster contact searches.
     length_scale: T,
     partners: Partners<T, D>,
+    /// Scratch for the partners a prediction gathers from cell lists (kept to avoid an
+    /// allocation per prediction).
+    gathered: Vec<u32>,
     calendar: Calendar<T>,
     pending: Array<Pending>,
     /// Internal (forward-running) time.
@@ -379,6 +382,7 @@ where
             balls,
             clusters: Vec::new(),
             partners,
+            gathered: Vec::new(),
             calendar: Calendar::sized_for(slots, T::one(), T::zero()),
             pending: Array::filled(slots, |_| Pending::None),
             now: T::zero(),

@@ -86,6 +86,21 @@ impl<const W: usize, A: Copy> IdRows<W, A> {
         row.ids[..in_row].iter().chain(spilled).copied()
     }
 
+    /// Appends the ids in list `i` to `out`, in the order of [`Self::of`]. The whole row
+    /// is copied and the copy cut to the list's length, so that a list's length does not
+    /// decide a branch (a loop over a short list's ids ends at an unpredictable place).
+    #[inline]
+    pub(crate) fn append_to(&self, i: usize, out: &mut Vec<u32>) {
+        let row = &self.rows[i];
+        let start = out.len();
+        let len = row.len as usize;
+        out.extend_from_slice(&row.ids);
+        out.truncate(start + len.min(W));
+        if len > W {
+            out.extend_from_slice(&self.spill[i]);
+        }
+    }
+
     /// The `k`-th id of list `i` (`k` below its length).
     #[inline]
     pub(crate) fn get(&self, i: usize, k: usize) -> u32 {
@@ -204,6 +219,17 @@ mod tests {
             }
         }
         assert!(longest > 31, "the test reached the spill");
+        let mut appended = vec![7];
+        for k in 0..n {
+            rows.append_to(k, &mut appended);
+        }
+        let listed: Vec<u32> = core::iter::once(7)
+            .chain((0..n).flat_map(|k| rows.of(k)))
+            .collect();
+        assert_eq!(
+            appended, listed,
+            "append_to copies each list as `of` lists it"
+        );
         rows.clear(1);
         assert_eq!(rows.of(1).count(), 0);
     }
