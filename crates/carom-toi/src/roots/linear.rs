@@ -154,9 +154,10 @@ pub(crate) fn certainly_clear<T: Real, const D: usize>(
     larger(larger(receding, missing), later) > T::zero()
 }
 
-/// The larger of `a` and `b`, and `a` when `b` is NaN: one `maxsd` on x86, where `max`
-/// (which passes over a NaN in either) costs three more instructions. A NaN `a` gives
-/// `a`, which proves nothing: the caller's proof is then lost, never wrong.
+/// The larger of `a` and `b`, and `a` when `b` is NaN. `max`, which passes over a NaN in
+/// either, cost the 3D gas 2 % more instructions (callgrind, `event_throughput 4000 0.45
+/// 3 1 1`: 1,718.8 against 1,681.5 million). A NaN `a` gives `a`, which proves nothing:
+/// the caller's proof is then lost, never wrong.
 #[inline]
 fn larger<T: Real>(a: T, b: T) -> T {
     if b > a { b } else { a }
