@@ -30,7 +30,11 @@
 //!    force** `F = P/(w τ)` (`w` the integrator's chord weight,
 //!    `Integrator::chord_weight`): a body's chord changes by `P/m`, its end velocity by
 //!    `P/(w m)` (twice the chord's with Verlet, RK4 and the exact integrator, as much with
-//!    semi-implicit Euler), its velocity at `s` not at all; torques alike. So a ball
+//!    semi-implicit Euler), its velocity at `s` not at all; a cluster's torques alike.
+//!    A free ball's spin is not: [`Contacts::push`] adds the hold's spin change to its
+//!    spin at `s` and at the step's end alike, an impulse at `s`, which a later re-hold
+//!    of the same step restarts from in full while it keeps only part of the push (the
+//!    3D pile draw's energy rise, `docs/stepped.md` piles item 17). So a ball
 //!    resting on a cluster passes its whole load's torque to the end of the step, and
 //!    what the ball and the cluster end the step with is what the force gave them: no
 //!    correction of the end velocities afterwards. Explicit Euler's chords are the start
