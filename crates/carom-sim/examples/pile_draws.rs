@@ -1,13 +1,15 @@
 //! The pile test's drop (`tests/stepped_resting.rs`, `drop_rows_of_balls`) over many
 //! draws of its generator: for each seed, 300 steps of rows of 16 balls dropped into a
-//! box 10 m wide (restitution 0.2, friction 0.3, semi-implicit Euler, `dt = 1/60`), the
+//! box 10 m wide (restitution 0.2, friction 0.3, semi-implicit Euler unless `INTEGRATOR`
+//! names another, `dt = 1/60`), the
 //! steps whose energy rose beyond what the narrow phase's allowance lets the pile's
 //! weight do, the largest such rise (in allowances and as a fraction of the energy),
 //! the fastest ball at 4 s and the run's wall time.
 //!
 //! ```sh
-//! cargo run --release -p carom-sim --example pile_draws -- [ROWS] [SEEDS] [FIRST] [DIM]
+//! cargo run --release -p carom-sim --example pile_draws -- [ROWS] [SEEDS] [FIRST] [DIM] [INTEGRATOR]
 //! cargo run --release -p carom-sim --example pile_draws -- 6 18
+//! cargo run --release -p carom-sim --example pile_draws -- 4 18 0 3 verlet
 //! ```
 //!
 //! The scenes are `carom_sim::scenes::pile::dropped_rows` (seed 0 is the test's own
@@ -43,7 +45,7 @@ where
 
 /// One draw: (steps above the allowance, largest rise in allowances, as a fraction of
 /// the energy, fastest ball at 4 s, wall seconds).
-fn draw<const D: usize>(rows: u32, seed: u64) -> (usize, f64, f64, f64, f64)
+fn draw<const D: usize>(rows: u32, seed: u64, integrator: Integrator) -> (usize, f64, f64, f64, f64)
 where
     Const<D>: Space<f64, D>,
 {
@@ -51,7 +53,7 @@ where
     let dt = 1.0 / 60.0;
     let options = RunOptions {
         engine: EngineChoice::Stepped,
-        integrator: Some(Integrator::SemiImplicitEuler),
+        integrator: Some(integrator),
         dt: Some(dt),
         broad: BroadChoice::Auto,
     };
@@ -87,18 +89,19 @@ where
 }
 
 fn main() {
-    let (rows, seeds, first, dim) = (
+    let (rows, seeds, first, dim, integrator) = (
         arg(1, 6_u32),
         arg(2, 18_u64),
         arg(3, 0_u64),
         arg(4, 2_usize),
+        arg(5, Integrator::SemiImplicitEuler),
     );
     let mut times = Vec::new();
     let mut draws_above = 0;
     for k in first..first + seeds {
         let (above, worst, fraction, at_4, wall) = match dim {
-            2 => draw::<2>(rows, k),
-            3 => draw::<3>(rows, k),
+            2 => draw::<2>(rows, k, integrator),
+            3 => draw::<3>(rows, k, integrator),
             other => panic!("argument 4: dimension {other} is not 2 or 3"),
         };
         draws_above += usize::from(above > 0);

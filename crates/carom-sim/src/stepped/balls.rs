@@ -196,6 +196,21 @@ where
         )
     }
 
+    /// The spin ball `i`'s contact points read along its chord (the spin's analogue of
+    /// the chord, which no array keeps: a sphere's orientation is not tracked), for an
+    /// integrator of chord weight `weight` (`Integrator::chord_weight`): the start spin
+    /// plus `weight` times the segment's change, `seg_w + w (spin − seg_w)`.
+    ///
+    /// A hold's torque shows in the spins as its force does in the velocities (see
+    /// `stack::spin_shares`): the start spin unchanged and the end spin by `Δω / w`, or
+    /// both by `Δω` for explicit Euler (`w = 0`), and either way this reading by `Δω`,
+    /// which is what the hold's problem counts on. A free ball's spin is constant
+    /// without drag, and this is its spin.
+    #[inline]
+    pub(crate) fn chord_spin(&self, i: usize, weight: T) -> Angular<T, D> {
+        self.seg_w[i] + (self.spin[i] - self.seg_w[i]) * weight
+    }
+
     /// Starts a new segment of ball `i` at `s`, on the same chord and with the same end:
     /// the travel is added to the remainder before it rounds, and what the rounding
     /// dropped is the new remainder (`x − seg_x` is exact when the two lie within a

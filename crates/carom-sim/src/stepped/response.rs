@@ -292,6 +292,13 @@ where
         Flight::new(self.stepper, self.h, self.t0)
     }
 
+    /// The spin ball `i`'s contact points read along its chord
+    /// ([`BallArrays::chord_spin`] at this integrator's chord weight).
+    pub(super) fn chord_spin(&self, i: usize) -> Angular<T, D> {
+        let weight = T::lit(self.stepper.integrator().chord_weight());
+        self.balls.chord_spin(i, weight)
+    }
+
     pub(super) fn body(&self, i: usize, v: Vector<T, D>, w: Angular<T, D>) -> Body<T, D> {
         let b = &*self.balls;
         Body::new_unchecked(
@@ -324,7 +331,7 @@ where
     ) -> Body<T, D> {
         let b = &*self.balls;
         if start != T::zero() || end <= T::zero() {
-            return self.body(i, b.chord[i], b.seg_w[i]);
+            return self.body(i, b.chord[i], self.chord_spin(i));
         }
         let across = |v: Vector<T, D>| v - n * v.dot(n);
         let slip = across(b.vel[i] - velocity) / end;
@@ -432,16 +439,30 @@ where
         // move towards it, is held as by an immovable surface, and is supported in turn.
         if self.holds_up(i, j, s) {
             let support = b.chord[j] - n * apart;
-            self.rest_on(i, Support::Ball(j as u32), &n, support, b.seg_w[j], s);
+            self.rest_on(
+                i,
+                Support::Ball(j as u32),
+                &n,
+                support,
+                self.chord_spin(j),
+                s,
+            );
         } else if self.holds_up(j, i, s) {
             let support = b.chord[i] + n * apart;
-            self.rest_on(j, Support::Ball(i as u32), &-n, support, b.seg_w[i], s);
+            self.rest_on(
+                j,
+                Support::Ball(i as u32),
+                &-n,
+                support,
+                self.chord_spin(i),
+                s,
+            );
         } else {
             // Two free balls closing along their chords: a perfectly inelastic correction
             // (momentum kept, energy never added).
             let (ci, cj) = (
-                self.body(i, b.chord[i], b.seg_w[i]),
-                self.body(j, b.chord[j], b.seg_w[j]),
+                self.body(i, b.chord[i], self.chord_spin(i)),
+                self.body(j, b.chord[j], self.chord_spin(j)),
             );
             let r = self.stop_closing(&ci, &cj, &contact);
             if r.applied() {
@@ -665,7 +686,7 @@ where
         let h = self.h;
         self.balls.restart(upper, s, h);
         let b = &*self.balls;
-        let spin = b.seg_w[lower];
+        let spin = self.chord_spin(lower);
         let surface = b.chord[lower]
             + <Const<D> as Space<T, D>>::angular_cross(&spin, &(n * -b.radius[lower]));
         let zero_spin = <Const<D> as Space<T, D>>::angular_zero();

@@ -30,11 +30,9 @@
 //!    force** `F = P/(w τ)` (`w` the integrator's chord weight,
 //!    `Integrator::chord_weight`): a body's chord changes by `P/m`, its end velocity by
 //!    `P/(w m)` (twice the chord's with Verlet, RK4 and the exact integrator, as much with
-//!    semi-implicit Euler), its velocity at `s` not at all; a cluster's torques alike.
-//!    A free ball's spin is not: [`Contacts::push`] adds the hold's spin change to its
-//!    spin at `s` and at the step's end alike, an impulse at `s`, which a later re-hold
-//!    of the same step restarts from in full while it keeps only part of the push (the
-//!    3D pile draw's energy rise, `docs/stepped.md` piles item 17). So a ball
+//!    semi-implicit Euler), its velocity at `s` not at all; torques alike, a free
+//!    ball's spin at the step's end by `Δω/w` and its contact points along the chord by
+//!    `Δω` (`BallArrays::chord_spin`, [`spin_shares`]). So a ball
 //!    resting on a cluster passes its whole load's torque to the end of the step, and
 //!    what the ball and the cluster end the step with is what the force gave them: no
 //!    correction of the end velocities afterwards. Explicit Euler's chords are the start
@@ -124,6 +122,26 @@ where
     match flight.end_per_chord(inverse_mass, seg_t) {
         Some(end_share) => (T::zero(), end_share),
         None => (T::one(), T::one()),
+    }
+}
+
+/// How a change `Δω` a hold's torque makes in a free ball's chord spin
+/// (`BallArrays::chord_spin`) shows in its spin at `seg_t` and at the step's end, as
+/// multiples of `Δω`, for an integrator of chord weight `w`: a constant torque over the
+/// rest of the step, `(0, 1/w)`, as [`shares`] has a force, but undamped by any spin
+/// drag, as a cluster's push is (`clusters::advance`: the drag acts on the free motion
+/// alone). The hold's problem reads contact points through the chord spin, which these
+/// shares change by `Δω` exactly, whatever `w`. With explicit Euler (`w = 0`) an impulse
+/// at `seg_t`, `(1, 1)`.
+///
+/// Adding `Δω` to both spins instead, an impulse at `seg_t` for every integrator, let a
+/// re-hold of the same step restart a ball with all of the last hold's spin and only
+/// part of its push: the 3D pile draw's energy rise (`docs/stepped.md`, piles item 17).
+fn spin_shares<T: Real>(w: T) -> (T, T) {
+    if w > T::zero() {
+        (T::zero(), T::one() / w)
+    } else {
+        (T::one(), T::one())
     }
 }
 
@@ -1597,11 +1615,11 @@ where
         let b = &*self.balls;
         match stack.parts[e.part].side {
             Side::Ball(i) => {
-                let v = match phase {
-                    Phase::Start => b.seg_v[i],
-                    Phase::Chord => b.chord[i],
+                let (v, w) = match phase {
+                    Phase::Start => (b.seg_v[i], b.seg_w[i]),
+                    Phase::Chord => (b.chord[i], self.chord_spin(i)),
                 };
-                v + <Const<D> as Space<T, D>>::angular_cross(&b.seg_w[i], &e.lever)
+                v + <Const<D> as Space<T, D>>::angular_cross(&w, &e.lever)
             }
             Side::Cluster(c) => {
                 let cluster = &self.clusters.list[c];
@@ -1857,8 +1875,8 @@ where
     /// Applies `changes` as the constant force of the rest of the step (see the module
     /// documentation), to the state before the hold: chords by `P/m`, end velocities by
     /// `P/(w m)` (`Integrator::end_per_chord` times `P/m` under drag), the velocities at
-    /// the segment start unchanged; spins as impulses. With explicit Euler (`w = 0`) no
-    /// force within the step moves a chord: impulses at the segment start.
+    /// the segment start unchanged; spins alike, by [`spin_shares`]. With explicit Euler
+    /// (`w = 0`) no force within the step moves a chord: impulses at the segment start.
     fn push(&mut self, stack: &Stack<T, D>, changes: &Changes<T, D>) {
         let w = T::lit(self.stepper.integrator().chord_weight());
         let flight = self.flight();
@@ -1868,13 +1886,14 @@ where
                 (Side::Ball(i), Free::Ball([seg_v, chord, vel], [seg_w, spin])) => {
                     let (start_share, end_share) =
                         shares(&flight, part.inverse_mass, self.balls.seg_t[i]);
+                    let (spin_start, spin_end) = spin_shares(w);
                     let dw =
                         <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
                     self.balls.set_segment(
                         i,
                         self.h,
                         [seg_v + dv * start_share, chord + dv, vel + dv * end_share],
-                        [seg_w + dw, spin + dw],
+                        [seg_w + dw * spin_start, spin + dw * spin_end],
                     );
                     self.rest
                         .restart(i, self.balls.seg_t[i], self.balls.chord[i]);
