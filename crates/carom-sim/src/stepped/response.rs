@@ -292,11 +292,15 @@ where
         Flight::new(self.stepper, self.h, self.t0)
     }
 
+    /// The integrator's chord weight `w` (`Integrator::chord_weight`).
+    pub(super) fn chord_weight(&self) -> T {
+        T::lit(self.stepper.integrator().chord_weight())
+    }
+
     /// The spin ball `i`'s contact points read along its chord
     /// ([`BallArrays::chord_spin`] at this integrator's chord weight).
     pub(super) fn chord_spin(&self, i: usize) -> Angular<T, D> {
-        let weight = T::lit(self.stepper.integrator().chord_weight());
-        self.balls.chord_spin(i, weight)
+        self.balls.chord_spin(i, self.chord_weight())
     }
 
     pub(super) fn body(&self, i: usize, v: Vector<T, D>, w: Angular<T, D>) -> Body<T, D> {

@@ -130,9 +130,11 @@ where
 /// multiples of `Δω`, for an integrator of chord weight `w`: a constant torque over the
 /// rest of the step, `(0, 1/w)`, as [`shares`] has a force, but undamped by any spin
 /// drag, as a cluster's push is (`clusters::advance`: the drag acts on the free motion
-/// alone). The hold's problem reads contact points through the chord spin, which these
-/// shares change by `Δω` exactly, whatever `w`. With explicit Euler (`w = 0`) an impulse
-/// at `seg_t`, `(1, 1)`.
+/// alone). With explicit Euler (`w = 0`) an impulse at `seg_t`, `(1, 1)`. The hold's
+/// problem reads contact points through the chord spin `seg_w + w (spin − seg_w)`, which
+/// shares `(a, b)` change by `a Δω + w (b − a) Δω`: `Δω` for both pairs, whatever `w`,
+/// as each of the hold's rounds counts on (it reads the chords after the last round's
+/// push and takes that push off again).
 ///
 /// Adding `Δω` to both spins instead, an impulse at `seg_t` for every integrator, let a
 /// re-hold of the same step restart a ball with all of the last hold's spin and only
@@ -1878,7 +1880,8 @@ where
     /// the segment start unchanged; spins alike, by [`spin_shares`]. With explicit Euler
     /// (`w = 0`) no force within the step moves a chord: impulses at the segment start.
     fn push(&mut self, stack: &Stack<T, D>, changes: &Changes<T, D>) {
-        let w = T::lit(self.stepper.integrator().chord_weight());
+        let w = self.chord_weight();
+        let (spin_start, spin_end) = spin_shares(w);
         let flight = self.flight();
         for (part, (linear, angular)) in stack.parts.iter().zip(&changes.impulse) {
             let dv = Changes::linear_change(part, linear);
@@ -1886,7 +1889,6 @@ where
                 (Side::Ball(i), Free::Ball([seg_v, chord, vel], [seg_w, spin])) => {
                     let (start_share, end_share) =
                         shares(&flight, part.inverse_mass, self.balls.seg_t[i]);
-                    let (spin_start, spin_end) = spin_shares(w);
                     let dw =
                         <Const<D> as Space<T, D>>::inertia_apply(&part.inverse_inertia, angular);
                     self.balls.set_segment(
