@@ -79,7 +79,10 @@
 //! negative: two balls sunk into each other deeper than the narrow phase's
 //! floor lets a contact sink (`narrow::sunk`), or a ball sunk so into a wall or a box,
 //! are aimed apart at their depth over the rest of the step (`−g/τ`), and the push that
-//! does it adds `2 λ |g|/τ`. The impacts are
+//! does it adds `2 λ |g|/τ`. Friction adds nothing where its rounds converge (a sliding
+//! row's impulse opposes its slip); rounds that end short of that can push along the
+//! slip, and a hold whose work then exceeds its rows' tolerance keeps only the share of
+//! its friction that fits (`Contacts::hold_work`). The impacts are
 //! inelastic impulses at `s`, which only take energy.
 
 use carom_geometry::Ball;
@@ -209,6 +212,12 @@ const SPARSE_FRICTION_ROUNDS: usize = 128;
 /// 3.4e4 J; none above 1 mJ there since `Warm` keeps forces over at least half a step;
 /// `docs/stepped.md`).
 const SPARSE_REHOLD_FRICTION_ROUNDS: usize = 16;
+
+/// Halvings of the interval searched for the share of an unconverged friction solution
+/// a hold keeps (`Contacts::fit_friction`): the share is found to
+/// 1/64, and a hold whose friction does not fit within its tolerance even at 1/64 is held
+/// without friction.
+const FRICTION_SHARE_HALVINGS: usize = 6;
 
 /// A body of a stack: a free ball or a cluster, restarted at the hold's instant.
 struct Part<T: Real, const D: usize>
@@ -1713,13 +1722,15 @@ where
     /// stop each closing faster than its `margins` entry, from the relative velocities
     /// `relative` and the approach speeds `approach` (both indexed by row, see
     /// [`Self::approach`]): normal impulses exactly (`lcp`), with friction the tangential
-    /// ones within Coulomb's cone in turn.
+    /// ones within Coulomb's cone in turn. `hold`: the rows are a hold's (chords held over
+    /// the rest of the step, [`Self::hold_work`] kept within its tolerance), not impacts
+    /// at an instant.
     fn impulses(
         &mut self,
         stack: &Stack<T, D>,
         rows: &[usize],
         (relative, approach, margins): (&[Vector<T, D>], &[T], &[T]),
-        warm: bool,
+        hold: bool,
     ) -> Vec<Wide<D>> {
         let n = rows.len();
         if n == 0 {
@@ -1738,7 +1749,7 @@ where
         // from no friction each time (see `stack::Warm`).
         let sparse = matches!(a, Delassus::Sparse(_));
         let pile = stack.approach == Approach::Resting;
-        let warm = warm && (sparse || pile) && rest > 0.0;
+        let warm = hold && (sparse || pile) && rest > 0.0;
         if warm {
             let rows = rows.iter().map(|&c| &stack.rows[c]);
             (self.solvers.warm).start(
@@ -1805,6 +1816,10 @@ where
         if (self.rules.has_gravity() && !settled) || (sparse && friction > T::zero()) {
             normal(self, &mut lambda, &tangential);
         }
+        if hold && !settled {
+            let held = (relative, margins);
+            self.fit_friction(stack, rows, held, (&mut lambda, &mut tangential), normal);
+        }
         if warm {
             let rows = rows.iter().map(|&c| &stack.rows[c]);
             let step = self.h.to_f64();
@@ -1815,6 +1830,99 @@ where
         (rows.iter().zip(lambda.iter().zip(&tangential)))
             .map(|(&c, (&l, t))| t - wide(&stack.rows[c].normal) * l)
             .collect()
+    }
+
+    /// Where a hold's friction, left unconverged by its rounds, makes the hold's work
+    /// ([`Self::hold_work`]) exceed its rows' tolerance: scales the tangential impulses
+    /// by the largest share, found by halving ([`FRICTION_SHARE_HALVINGS`]), whose hold
+    /// stays within it, the normal impulses solved again by `normal` for each share; by
+    /// 0 where none does (a hold without friction only takes energy).
+    fn fit_friction(
+        &mut self,
+        stack: &Stack<T, D>,
+        rows: &[usize],
+        held: (&[Vector<T, D>], &[T]),
+        (lambda, tangential): (&mut Vec<f64>, &mut Vec<Wide<D>>),
+        mut normal: impl FnMut(&mut Self, &mut [f64], &[Wide<D>]),
+    ) {
+        let (work, allowed) = self.hold_work(stack, rows, held, lambda, tangential);
+        if work <= allowed {
+            return;
+        }
+        let full = core::mem::take(tangential);
+        let (mut kept, mut refused) = (0.0, 1.0);
+        let mut best = None;
+        for _ in 0..FRICTION_SHARE_HALVINGS {
+            let share = 0.5 * (kept + refused);
+            let t: Vec<Wide<D>> = full.iter().map(|f| f * share).collect();
+            let mut l = lambda.clone();
+            normal(self, &mut l, &t);
+            let (work, allowed) = self.hold_work(stack, rows, held, &l, &t);
+            if work <= allowed {
+                kept = share;
+                best = Some((l, t));
+            } else {
+                refused = share;
+            }
+        }
+        (*lambda, *tangential) = best.unwrap_or_else(|| {
+            let t = vec![Wide::<D>::zeros(); full.len()];
+            normal(self, lambda, &t);
+            (core::mem::take(lambda), t)
+        });
+    }
+
+    /// The work of a hold's impulses on `rows` (normal `lambda`, tangential `tangential`)
+    /// against the chords they leave, and the most its rows' tolerance lets it be: `(Σ
+    /// P·u', Σ λ done)`, the normal part left out where a row's margin is negative (a
+    /// sunk contact, aimed apart: its push adds energy by design, see the module
+    /// documentation).
+    ///
+    /// Why this measures the energy a hold adds: a force held over the rest `τ` of the
+    /// step changes a body's chord by `Δc = P/m` and its end velocity by `Δc/w`. With an
+    /// integrator exact for constant gravity (`w = ½`: the end velocity is `c + g τ/2`,
+    /// the end position moves by `τ Δc`), the energy at the step's end changes by
+    /// `m (2 Δc·(c + g τ/2) + 2 Δc²) − m g·τ Δc = 2 m Δc·(c + Δc) = 2 P·c'`, the spins'
+    /// alike (`spin_shares`); summed over the bodies and written per contact, `2 Σ P·u'`.
+    /// An exact Coulomb solution makes every term `≤ 0`: a normal impulse pushes only
+    /// where its row closes at its margin (`−λ g/τ`), a sliding row's friction opposes its
+    /// slip and a sticking row's does not slip. Friction whose rounds stopped short of
+    /// that (they converge linearly, slowly in a pile, and the last normal solve moves
+    /// the slips again) can push along the slip, and a sloshing pile's hold added 4.1e-5
+    /// J so, 11 times what the narrow phase's allowance lets its weight do
+    /// (`docs/stepped.md`, piles item 19). The bound `Σ λ done` is what rows left closing
+    /// within [`Self::done`] may take; with semi-implicit Euler (`w = 1`) the same sum
+    /// bounds the chords' own kinetic energy change, `P·(u + u')/2 <= P·u'`.
+    fn hold_work(
+        &self,
+        stack: &Stack<T, D>,
+        rows: &[usize],
+        (relative, margins): (&[Vector<T, D>], &[T]),
+        lambda: &[f64],
+        tangential: &[Wide<D>],
+    ) -> (f64, f64) {
+        let mut changes = Changes::new(stack.parts.len());
+        for (k, &c) in rows.iter().enumerate() {
+            let p = tangential[k] - wide(&stack.rows[c].normal) * lambda[k];
+            for (e, sign) in stack.ends(c) {
+                changes.add(&e, sign, &p);
+            }
+        }
+        let (mut work, mut allowed) = (0.0, 0.0);
+        for (k, &c) in rows.iter().enumerate() {
+            let normal = wide(&stack.rows[c].normal);
+            let moved = stack.ends(c).fold(Vector::zeros(), |sum, (e, sign)| {
+                sum + changes.at(stack, &e) * sign
+            });
+            let u = wide(&(relative[c] + moved));
+            let along = u.dot(&normal);
+            work += tangential[k].dot(&(u - normal * along));
+            if margins[k] >= T::zero() {
+                work -= lambda[k] * along;
+            }
+            allowed += lambda[k] * self.done(stack, c).to_f64();
+        }
+        (work, allowed)
     }
 
     /// The bodies' impulses of `impulses` on `rows`; marks the rows that push.
