@@ -745,8 +745,8 @@ fn a_dropped_3d_pile_gains_no_energy_from_its_holds_torques() {
 
 /// The 2D drop's draw where friction left unconverged by a hold's rounds pushed along
 /// the slip: seed 6 with Verlet, the pile sloshing from wall to wall, rose by 11.1
-/// allowances at step 138, a hold's tangential impulses doing 5.6e-5 J of work where an
-/// exact Coulomb solution does none (`docs/stepped.md`, piles item 19). The hold now
+/// allowances at step 138, a hold's tangential impulses adding 5.6e-5 J where an exact
+/// Coulomb solution adds none (`docs/stepped.md`, piles item 19). The hold now
 /// keeps only the share of such friction that adds no more than its rows' tolerance.
 #[test]
 fn a_sloshing_2d_pile_gains_no_energy_from_friction_left_unconverged() {
