@@ -148,6 +148,18 @@ where
         self.restitution[i].min(self.restitution[j])
     }
 
+    /// Prefetches what a prediction against ball `i` reads of it
+    /// (`narrow::Narrow::ball_ball`): its cluster, segment, chord, radius and version.
+    #[inline]
+    pub(crate) fn prefetch_partner(&self, i: usize) {
+        prefetch(&self.cluster[i]);
+        prefetch(&self.seg_x[i]);
+        prefetch(&self.seg_t[i]);
+        prefetch(&self.chord[i]);
+        prefetch(&self.radius[i]);
+        prefetch(&self.version[i]);
+    }
+
     /// Prefetches every field of ball `i` (see `prefetch`).
     pub(crate) fn prefetch_row(&self, i: usize) {
         prefetch(&self.radius[i]);

@@ -79,6 +79,8 @@ use self::wedge::{Repeat, Repeats, WEDGE_CONTACTS, wedge_limit};
 /// Escapees per parallel task of the step's first predictions (each is a broad-phase
 /// query and a few times of impact: 1.4 µs on average, timed on a 1e5-ball gas).
 const ESCAPEE_CHUNK: usize = 32;
+/// How many pairs ahead the prediction of all pairs asks for a pair's second ball.
+const PAIR_PREFETCH_AHEAD: usize = 8;
 use crate::engine::{BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation};
 use crate::plan::{DEFAULT_DT, Plan, can_stick, stepped_broad_phase};
 use crate::scene::{Scene, SceneError};
@@ -622,8 +624,15 @@ where
                 Ok(())
             };
             if c < pair_chunks {
-                let end = ((c + 1) * CHUNK).min(pairs.len());
-                for &(i, j) in &pairs[c * CHUNK..end] {
+                let chunk = &pairs[c * CHUNK..((c + 1) * CHUNK).min(pairs.len())];
+                for (k, &(i, j)) in chunk.iter().enumerate() {
+                    // The second ball of a pair is anywhere in memory; its data is asked
+                    // for a few pairs ahead so that the misses overlap.
+                    if let Some(&(_, ahead)) = chunk.get(k + PAIR_PREFETCH_AHEAD)
+                        && (ahead as usize) < n
+                    {
+                        narrow.balls.prefetch_partner(ahead as usize);
+                    }
                     let (i, j) = (i as usize, j as usize);
                     if j < n {
                         push(narrow.ball_ball(i, j, a))?;

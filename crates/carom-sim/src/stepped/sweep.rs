@@ -149,12 +149,12 @@ where
             let cores = &self.cores;
             let collect = |c: usize, out: &mut Vec<u32>| {
                 out.clear();
-                let first = c * CHUNK;
-                for (i, core) in (first..).zip(&cores[first..(first + CHUNK).min(n)]) {
-                    let fits = [balls.seg_x[i], balls.pos[i]]
-                        .iter()
-                        .all(|p| (0..D).all(|k| core.min()[k] <= p[k] && p[k] <= core.max()[k]));
-                    if !fits {
+                let (first, last) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
+                let (start, end) = (&balls.seg_x[first..last], &balls.pos[first..last]);
+                for (i, ((core, x), p)) in
+                    (first..).zip(cores[first..last].iter().zip(start).zip(end))
+                {
+                    if !(core.contains_point(x) & core.contains_point(p)) {
                         out.push(i as u32);
                     }
                 }
