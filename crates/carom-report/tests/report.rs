@@ -258,7 +258,7 @@ fn the_summary_sets_each_target_beside_its_reference() {
     // ratio to this report's rate, which was not measured beside it.
     let (low, high) = carom_report::targets::EDMD;
     let beside = format!(
-        "EDMD {:.2}–{:.2} M/s on {}, carom 0.74 M/s beside it (1.08–1.19× EDMD; not this run)",
+        "EDMD {:.2}–{:.2} M/s on {}, carom 0.99 M/s beside it (1.16–1.18× EDMD; not this run)",
         low / 1e6,
         high / 1e6,
         carom_report::targets::EDMD_MEASURED,
