@@ -160,9 +160,10 @@ where
         prefetch(&self.version[i]);
     }
 
-    /// Prefetches every field of ball `i` (see `prefetch`).
+    /// Prefetches every field of ball `i` (see `prefetch`): what a prediction reads
+    /// ([`Self::prefetch_partner`]) and the rest.
     pub(crate) fn prefetch_row(&self, i: usize) {
-        prefetch(&self.radius[i]);
+        self.prefetch_partner(i);
         prefetch(&self.mass[i]);
         prefetch(&self.inverse_mass[i]);
         prefetch(&self.inverse_inertia[i]);
@@ -170,15 +171,10 @@ where
         prefetch(&self.pos[i]);
         prefetch(&self.vel[i]);
         prefetch(&self.spin[i]);
-        prefetch(&self.seg_t[i]);
-        prefetch(&self.seg_x[i]);
         prefetch(&self.seg_r[i]);
         prefetch(&self.seg_v[i]);
         prefetch(&self.seg_w[i]);
-        prefetch(&self.chord[i]);
-        prefetch(&self.version[i]);
         prefetch(&self.supported[i]);
-        prefetch(&self.cluster[i]);
     }
 
     /// Position of ball `i` at in-step time `s` on its segment.

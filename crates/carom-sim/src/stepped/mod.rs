@@ -76,14 +76,17 @@ use self::stack::{Groups, SeedOther, Solvers};
 use self::sweep::{CHUNK, Sweep, clear_of, path_box};
 use self::wedge::{Repeat, Repeats, WEDGE_CONTACTS, wedge_limit};
 
-/// Escapees per parallel task of the step's first predictions (each is a broad-phase
-/// query and a few times of impact: 1.4 µs on average, timed on a 1e5-ball gas).
-const ESCAPEE_CHUNK: usize = 32;
-/// How many pairs ahead the prediction of all pairs asks for a pair's second ball.
-const PAIR_PREFETCH_AHEAD: usize = 8;
 use crate::engine::{BallStates, Collision, Counters, EngineKind, Observer, SimError, Simulation};
 use crate::plan::{DEFAULT_DT, Plan, can_stick, stepped_broad_phase};
 use crate::scene::{Scene, SceneError};
+
+/// Escapees per parallel task of the step's first predictions (each is a broad-phase
+/// query and a few times of impact: 1.4 µs on average, timed on a 1e5-ball gas).
+const ESCAPEE_CHUNK: usize = 32;
+
+/// How many pairs ahead the prediction of all pairs asks for a pair's second ball
+/// (4, 8 and 16 timed: 8 and 16 level, both faster than 4 and than none; docs/stepped.md).
+const PAIR_PREFETCH_AHEAD: usize = 8;
 
 /// How often [`Observer::progress`] is called: every this many steps.
 const PROGRESS_EVERY: u64 = 256;
